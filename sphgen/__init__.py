@@ -1,0 +1,1 @@
+"""sphgen: SPH equations in restricted Python, compiled per scene."""

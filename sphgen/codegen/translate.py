@@ -1,0 +1,304 @@
+"""From a restricted-Python method to a specialised Cython function.
+
+1. ``specialise``: parse the method, fold ``self.<switch>`` into literals, turn other
+   ``self.<param>`` into module globals, prune branches whose test became a constant,
+   auto-declare integer ``range`` loop counters, drop arguments nobody uses.
+2. ``usage``: which ``d_*``/``s_*`` properties the specialised body reads and writes.
+3. ``to_cython``: hand the specialised function to compyle's CythonGenerator and return a
+   ``cdef inline ... noexcept nogil`` function whose lines carry ``# @src`` markers so a
+   compile error can be traced back to the equation and source line.
+"""
+import ast
+import inspect
+import linecache
+import textwrap
+import types
+
+from compyle.api import declare  # noqa: F401  (used by translated code)
+from compyle.cython_generator import CythonGenerator
+from compyle.types import KnownType
+
+from ..equation import PAIR_SYMBOLS, VECTOR_SYMBOLS
+
+
+class TranslationError(Exception):
+    """A method uses Python the generator cannot translate."""
+
+
+_INT_TYPES = {"int": "int*"}
+
+
+def _const_value(node):
+    return node.value if isinstance(node, ast.Constant) else None
+
+
+class _Specialiser(ast.NodeTransformer):
+    """Fold switches, rename params, prune constant branches."""
+
+    def __init__(self, constants, param_names, prefix, methods=()):
+        self.methods = set(methods)
+        self.constants = constants
+        self.param_names = param_names
+        self.prefix = prefix
+        self.globals_used = set()
+
+    def visit_Attribute(self, node):
+        self.generic_visit(node)
+        if isinstance(node.value, ast.Name) and node.value.id == "self":
+            if node.attr in self.constants:
+                val = self.constants[node.attr]
+                if isinstance(val, bool):
+                    val = int(val)
+                return ast.copy_location(ast.Constant(val), node)
+            if node.attr in self.param_names:
+                name = f"{self.prefix}_{node.attr}"
+                self.globals_used.add(node.attr)
+                return ast.copy_location(ast.Name(id=name, ctx=ast.Load()), node)
+            if node.attr in self.methods:
+                return ast.copy_location(ast.Name(id=f"{self.prefix}_{node.attr}", ctx=ast.Load()), node)
+            raise TranslationError(f"self.{node.attr} is not a parameter of this object")
+        return node
+
+    def visit_UnaryOp(self, node):
+        self.generic_visit(node)
+        v = _const_value(node.operand)
+        if v is not None and not isinstance(v, str):
+            try:
+                return ast.copy_location(ast.Constant(eval(compile(ast.Expression(node), "", "eval"))), node)
+            except Exception:
+                return node
+        return node
+
+    def visit_BinOp(self, node):
+        self.generic_visit(node)
+        if _const_value(node.left) is not None and _const_value(node.right) is not None:
+            try:
+                return ast.copy_location(ast.Constant(eval(compile(ast.Expression(node), "", "eval"))), node)
+            except Exception:
+                return node
+        return node
+
+    def visit_Compare(self, node):
+        self.generic_visit(node)
+        vals = [node.left] + list(node.comparators)
+        if all(isinstance(v, ast.Constant) for v in vals):
+            return ast.copy_location(ast.Constant(bool(eval(compile(ast.Expression(node), "", "eval")))), node)
+        return node
+
+    def visit_BoolOp(self, node):
+        self.generic_visit(node)
+        consts = [_const_value(v) for v in node.values]
+        is_and = isinstance(node.op, ast.And)
+        if any(isinstance(v, ast.Constant) and bool(v.value) != is_and for v in node.values):
+            return ast.copy_location(ast.Constant(not is_and), node)
+        rest = [v for v, c in zip(node.values, consts) if not isinstance(v, ast.Constant)]
+        if not rest:
+            return ast.copy_location(ast.Constant(is_and), node)
+        if len(rest) == 1:
+            return rest[0]
+        node.values = rest
+        return node
+
+    def visit_If(self, node):
+        self.generic_visit(node)
+        if isinstance(node.test, ast.Constant):
+            body = node.body if node.test.value else node.orelse
+            return body or None
+        if not node.body:
+            node.body = [ast.Pass()]
+        return node
+
+    def visit_IfExp(self, node):
+        self.generic_visit(node)
+        if isinstance(node.test, ast.Constant):
+            return node.body if node.test.value else node.orelse
+        return node
+
+
+def _names(tree):
+    return {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)}
+
+
+def _is_empty(body):
+    return all(isinstance(s, (ast.Pass,)) or (isinstance(s, ast.Expr) and isinstance(s.value, ast.Constant))
+               for s in body)
+
+
+class Specialised:
+    """A method after specialisation: its AST, arguments, and property usage."""
+
+    def __init__(self, owner, method, fdef, params_used, filename, firstline):
+        self.owner = owner
+        self.method = method
+        self.fdef = fdef
+        self.params_used = params_used
+        self.filename = filename
+        self.firstline = firstline
+        self.args = [a.arg for a in fdef.args.args]
+        self.reads, self.writes = _usage(fdef)
+
+    @property
+    def empty(self):
+        return _is_empty(self.fdef.body)
+
+    def props(self, prefix):
+        """Property names with the given prefix ('d_' or 's_') that the body touches."""
+        return {a[2:] for a in self.args if a.startswith(prefix) and a not in ("d_idx", "s_idx")}
+
+    @property
+    def pair_symbols(self):
+        return [a for a in self.args if a in PAIR_SYMBOLS]
+
+
+def _usage(fdef):
+    """(reads, writes): sets of argument names read / written through subscripts."""
+    reads, writes = set(), set()
+    for node in ast.walk(fdef):
+        if isinstance(node, ast.Subscript) and isinstance(node.value, ast.Name):
+            name = node.value.id
+            if isinstance(node.ctx, ast.Store):
+                writes.add(name)
+            else:
+                reads.add(name)
+        elif isinstance(node, ast.Name) and isinstance(node.ctx, ast.Load):
+            reads.add(node.id)
+    for node in ast.walk(fdef):
+        if isinstance(node, ast.AugAssign) and isinstance(node.target, ast.Subscript):
+            # ``d_au[d_idx] += ...`` both reads and writes the property
+            reads.add(node.target.value.id)
+    return reads, writes
+
+
+def method_source(func):
+    """(dedented source, filename, first line) of a function or method."""
+    try:
+        lines, first = inspect.getsourcelines(func)
+    except (OSError, TypeError) as e:
+        raise TranslationError(f"cannot read the source of {func.__qualname__}: {e}") from None
+    return textwrap.dedent("".join(lines)), inspect.getsourcefile(func) or "<unknown>", first
+
+
+def specialise(owner, method, constants, prefix, keep_defaults=False):
+    """Specialise ``owner.method`` into a function named ``<prefix>_<method>``.
+
+    ``constants`` are folded; other numeric attributes become globals ``<prefix>_<name>``.
+    """
+    func_name = method if prefix is None else f"{prefix}_{method}"
+    func = getattr(type(owner), method) if not isinstance(owner, types.FunctionType) else owner
+    src, filename, first = method_source(func)
+    tree = ast.parse(src)
+    fdef = tree.body[0]
+    if not isinstance(fdef, ast.FunctionDef):
+        raise TranslationError(f"{func.__qualname__} is not a plain function")
+    ast.increment_lineno(tree, first - 1)
+    fdef.decorator_list = []
+    if fdef.body and isinstance(fdef.body[0], ast.Expr) and isinstance(fdef.body[0].value, ast.Constant):
+        fdef.body = fdef.body[1:] or [ast.Pass()]
+    params = {} if isinstance(owner, types.FunctionType) else {
+        k: v for k, v in vars(owner).items() if not k.startswith("_")}
+    if fdef.args.args and fdef.args.args[0].arg == "self":
+        fdef.args.args = fdef.args.args[1:]
+        fdef.args.defaults = fdef.args.defaults[-len(fdef.args.args):] if fdef.args.args else []
+    numeric = {k for k, v in params.items() if isinstance(v, (int, float)) and k not in constants}
+    methods = [m for m in dir(type(owner)) if not m.startswith("_") and callable(getattr(type(owner), m))]
+    sp = _Specialiser(constants, numeric, prefix, methods)
+    fdef = sp.visit(fdef)
+    if not fdef.body:
+        fdef.body = [ast.Pass()]
+    _declare_loop_counters(fdef)
+    used = _names(ast.Module(body=fdef.body, type_ignores=[]))
+    keep = [a for a in fdef.args.args if a.arg in used]
+    if not keep_defaults:
+        fdef.args.defaults = []
+        fdef.args.args = keep
+    fdef.name = func_name
+    ast.fix_missing_locations(fdef)
+    return Specialised(owner, method, fdef, sp.globals_used, filename, first)
+
+
+def _declare_loop_counters(fdef):
+    """Declare ``for i in range(...)`` counters as int unless the user did."""
+    declared = set()
+    for node in ast.walk(fdef):
+        if isinstance(node, ast.Assign) and isinstance(node.value, ast.Call) and \
+                isinstance(node.value.func, ast.Name) and node.value.func.id == "declare":
+            for t in node.targets:
+                declared |= _names(t)
+    counters = []
+    for node in ast.walk(fdef):
+        if isinstance(node, ast.For) and isinstance(node.target, ast.Name) and \
+                isinstance(node.iter, ast.Call) and getattr(node.iter.func, "id", "") == "range":
+            if node.target.id not in declared and node.target.id not in counters:
+                counters.append(node.target.id)
+    decls = [ast.parse(f"{c} = declare('int')").body[0] for c in counters]
+    for d in decls:
+        ast.copy_location(d, fdef)
+    fdef.body = decls + fdef.body
+
+
+class _MarkedUnparser(ast._Unparser):
+    """Unparse with a ``# @src file:line`` comment before every statement."""
+
+    def __init__(self, filename):
+        super().__init__()
+        self._file = filename
+        self._pending = None
+
+    def traverse(self, node):
+        if isinstance(node, ast.stmt) and hasattr(node, "lineno") and not isinstance(node, ast.FunctionDef):
+            self._pending = node.lineno
+        super().traverse(node)
+
+    def fill(self, text=""):
+        if self._pending is not None:
+            self._source.append("\n" + "    " * self._indent + f"# @src {self._file}:{self._pending}")
+            self._pending = None
+        super().fill(text)
+
+
+def _arg_type(name, dtypes):
+    if name in ("d_idx", "s_idx"):
+        return "long"
+    if name in ("NBRS",):
+        return "int*"
+    if name in ("N_NBRS",):
+        return "long"
+    if name in VECTOR_SYMBOLS:
+        return "double*"
+    if name in PAIR_SYMBOLS or name in ("t", "dt"):
+        return "double"
+    if name.startswith(("d_", "s_")):
+        return dtypes.get(name, "double") + "*"
+    return None
+
+
+def to_cython(spec, dtypes=None, helper=False):
+    """Cython source of a specialised function, typed and ``noexcept nogil``."""
+    dtypes = dtypes or {}
+    fname = f"<sphgen:{spec.fdef.name}>"
+    src = _MarkedUnparser(spec.filename).visit(ast.Module(body=[spec.fdef], type_ignores=[]))
+    src = src.lstrip("\n") + "\n"
+    linecache.cache[fname] = (len(src), None, src.splitlines(True), fname)
+    namespace = {}
+    exec(compile(src, fname, "exec"), namespace)
+    func = namespace[spec.fdef.name]
+    known = {}
+    if not helper:
+        for a in spec.args:
+            t = _arg_type(a, dtypes)
+            if t is None:
+                raise TranslationError(
+                    f"argument '{a}' is neither a property (d_*/s_*), a pair symbol "
+                    f"({', '.join(PAIR_SYMBOLS)}) nor one of d_idx, s_idx, t, dt, NBRS, N_NBRS")
+            known[a] = KnownType(t)
+    gen = CythonGenerator(known_types=known)
+    try:
+        gen.parse(func)
+    except Exception as e:  # compyle raises a variety of errors
+        raise TranslationError(str(e)) from None
+    code = gen.get_code()
+    head, _, body = code.partition("\n")
+    head = head.replace("noexcept:", "noexcept nogil:")
+    if "nogil" not in head:
+        head = head.rstrip(":") + " nogil:"
+    return head + "\n" + body

@@ -1,0 +1,94 @@
+"""Smoothing kernels as translatable code: w, dw/dr, h dw/dh.
+
+A kernel is a class whose methods ``w(rij, h)``, ``dwdr(rij, h)`` and ``gradh(rij, h)``
+are restricted Python.  Its attributes (``dim``, ``fac``) are folded into the generated
+code as constants, so the compiled kernel is specialised on the dimension.
+"""
+from math import pi
+
+
+class Kernel:
+    """Base class: ``radius_scale`` is the support radius in units of h."""
+
+    radius_scale = 2.0
+    name = "kernel"
+
+    def __init__(self, dim):
+        if dim not in (1, 2, 3):
+            raise ValueError(f"kernel dimension must be 1, 2 or 3, got {dim!r}")
+        self.dim = dim
+
+    def constants(self):
+        """Attributes folded into the generated code."""
+        return {"dim": self.dim, "fac": self.fac}
+
+    def __repr__(self):
+        return f"{type(self).__name__}(dim={self.dim})"
+
+
+class QuinticSpline(Kernel):
+    """Quintic spline, support 3h (seed 002 section 2.2; Morris et al. 1997)."""
+
+    radius_scale = 3.0
+    name = "quintic"
+
+    def __init__(self, dim):
+        super().__init__(dim)
+        self.fac = {1: 1.0 / 120.0, 2: 7.0 / (478.0 * pi), 3: 1.0 / (120.0 * pi)}[dim]
+
+    def w(self, rij=1.0, h=1.0):
+        """W(r, h) = sigma/h^d [(3-q)^5 - 6(2-q)^5 + 15(1-q)^5] on the pieces of q = r/h."""
+        hi = 1.0 / h
+        q = rij * hi
+        s = self.fac * hi
+        if self.dim > 1:
+            s = s * hi
+        if self.dim > 2:
+            s = s * hi
+        t3 = 3.0 - q
+        t2 = 2.0 - q
+        t1 = 1.0 - q
+        val = 0.0
+        if q < 1.0:
+            val = t3 * t3 * t3 * t3 * t3 - 6.0 * t2 * t2 * t2 * t2 * t2 + 15.0 * t1 * t1 * t1 * t1 * t1
+        elif q < 2.0:
+            val = t3 * t3 * t3 * t3 * t3 - 6.0 * t2 * t2 * t2 * t2 * t2
+        elif q < 3.0:
+            val = t3 * t3 * t3 * t3 * t3
+        return s * val
+
+    def dwdr(self, rij=1.0, h=1.0):
+        """dW/dr of the quintic spline."""
+        hi = 1.0 / h
+        q = rij * hi
+        s = self.fac * hi * hi
+        if self.dim > 1:
+            s = s * hi
+        if self.dim > 2:
+            s = s * hi
+        t3 = 3.0 - q
+        t2 = 2.0 - q
+        t1 = 1.0 - q
+        val = 0.0
+        if q < 1.0:
+            val = -5.0 * (t3 * t3 * t3 * t3 - 6.0 * t2 * t2 * t2 * t2 + 15.0 * t1 * t1 * t1 * t1)
+        elif q < 2.0:
+            val = -5.0 * (t3 * t3 * t3 * t3 - 6.0 * t2 * t2 * t2 * t2)
+        elif q < 3.0:
+            val = -5.0 * t3 * t3 * t3 * t3
+        return s * val
+
+    def gradh(self, rij=1.0, h=1.0):
+        """h dW/dh = -(d W + r dW/dr)."""
+        return -(self.dim * self.w(rij, h) + rij * self.dwdr(rij, h))
+
+
+KERNELS = {"quintic": QuinticSpline}
+
+
+def get_kernel(name, dim):
+    """Kernel by name, e.g. ``get_kernel('quintic', 2)``."""
+    try:
+        return KERNELS[name](dim)
+    except KeyError:
+        raise ValueError(f"unknown kernel {name!r}; known: {', '.join(KERNELS)}") from None

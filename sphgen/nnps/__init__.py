@@ -1,0 +1,331 @@
+"""Neighbour search: cell-linked lists and CSR neighbour lists (compiled, OpenMP).
+
+``NeighbourSearch(arrays, dim, radius_scale, domain)`` bins all particles of all
+arrays into one grid of cells of edge ``radius_scale * max(h)`` and gives, for a
+(dest, src) pair of arrays, the CSR lists ``(offsets, nbrs)`` (int32) of the source
+particles ``j`` with ``|x_i - x_j| < radius_scale * max(h_i, h_j)``.  Periodic axes
+use the minimum-image convention; no ghost particles are ever created.
+
+Typical use in a time loop::
+
+    nnps = NeighbourSearch([fluid, solid], dim=2, radius_scale=3.0, domain=domain)
+    for step in ...:
+        nnps.update()                      # after the positions moved
+        offsets, nbrs = nnps.neighbours("fluid", "solid")
+
+The heavy work is in ``_cell_list.pyx``; this module chooses the grid, validates the
+input and caches the lists.
+"""
+import math
+
+import numpy as np
+
+from ._cell_list import GridSpec, bin_particles, build_csr, remap_csr, scan, wrap_periodic
+
+__all__ = ["Domain", "NeighbourSearch", "NotFrozenError"]
+
+_AXES = ("x", "y", "z")
+# Cells are a little larger than the cut-off so that floating-point rounding in the
+# cell coordinates can never put two neighbours two cells apart.
+_CELL_MARGIN = 1.0 + 1e-9
+
+
+class NotFrozenError(KeyError):
+    """``reference_neighbours`` was asked for a pair that was never frozen."""
+
+    def __str__(self):  # KeyError would print the repr of the message
+        return str(self.args[0]) if self.args else ""
+
+
+class Domain:
+    """Box [xmin,xmax]x[ymin,ymax]x[zmin,zmax] with per-axis periodicity.
+
+    Only periodic axes use the box: positions are wrapped into ``[lo, hi)`` and
+    separations follow the minimum-image convention.  Non-periodic axes are open
+    (the cell grid covers the particles, wherever they are).
+    """
+
+    def __init__(self, xmin=0., xmax=0., ymin=0., ymax=0., zmin=0., zmax=0.,
+                 periodic_in_x=False, periodic_in_y=False, periodic_in_z=False):
+        lo = (xmin, ymin, zmin)
+        hi = (xmax, ymax, zmax)
+        periodic = (bool(periodic_in_x), bool(periodic_in_y), bool(periodic_in_z))
+        for a, name in enumerate(_AXES):
+            try:
+                lo_a, hi_a = float(lo[a]), float(hi[a])
+            except (TypeError, ValueError):
+                raise ValueError(f"Domain: {name}min/{name}max must be numbers, got "
+                                 f"{lo[a]!r}, {hi[a]!r}") from None
+            if not (math.isfinite(lo_a) and math.isfinite(hi_a)):
+                raise ValueError(f"Domain: {name}min={lo[a]!r}, {name}max={hi[a]!r} must be finite")
+            if hi_a < lo_a:
+                raise ValueError(f"Domain: {name}max={hi_a} is below {name}min={lo_a}")
+            if periodic[a] and not hi_a > lo_a:
+                raise ValueError(f"Domain: periodic in {name} needs {name}max > {name}min, got "
+                                 f"{name}min={lo_a}, {name}max={hi_a}")
+        self.lo = tuple(float(v) for v in lo)
+        self.hi = tuple(float(v) for v in hi)
+        self.length = tuple(h - l for l, h in zip(self.lo, self.hi))
+        self.periodic = periodic
+
+    @property
+    def is_periodic(self):
+        return any(self.periodic)
+
+    def __repr__(self):
+        box = ", ".join(f"{n}=[{l}, {h}]" + (" periodic" if p else "")
+                        for n, l, h, p in zip(_AXES, self.lo, self.hi, self.periodic))
+        return f"Domain({box})"
+
+
+def _morton_rank(n, dim):
+    """int32 array: storage rank of each linear cell ``ix + nx*(iy + ny*iz)``, so
+    that cells sorted by rank follow the Morton (Z-order) curve."""
+    nx, ny, nz = n
+    ncells = nx * ny * nz
+    lin = np.arange(ncells, dtype=np.int64)
+    coords = (lin % nx, (lin // nx) % ny, lin // (nx * ny))
+    bits = max(1, int(max(n) - 1).bit_length())
+    key = np.zeros(ncells, dtype=np.uint64)
+    for b in range(bits):
+        for a in range(dim):
+            bit = (coords[a] >> b) & 1
+            key |= bit.astype(np.uint64) << np.uint64(dim * b + a)
+    order = np.argsort(key, kind="stable")
+    rank = np.empty(ncells, dtype=np.int32)
+    rank[order] = np.arange(ncells, dtype=np.int32)
+    return rank
+
+
+class NeighbourSearch:
+    """Cell-linked-list neighbour search over several particle arrays.
+
+    Parameters
+    ----------
+    arrays : list of ParticleArray (distinct names); each needs ``x`` (``y``, ``z``
+        up to ``dim``) and ``h``.
+    dim : 1, 2 or 3; only the first ``dim`` coordinates count in distances.
+    radius_scale : the kernel support factor k: neighbours have
+        ``|r_ij| < k * max(h_i, h_j)``.
+    domain : a :class:`Domain` (periodic axes), or None (open in every axis).
+    sort : if True, spatially sort the arrays once at construction (``sort()``).
+
+    The lists are built at construction; call :meth:`update` whenever positions or
+    ``h`` changed (the lists use the cells built by the last update).
+    """
+
+    def __init__(self, arrays, dim, radius_scale, domain=None, sort=True):
+        arrays = list(arrays)
+        if not arrays:
+            raise ValueError("NeighbourSearch needs at least one particle array")
+        names = [getattr(pa, "name", None) for pa in arrays]
+        for pa, name in zip(arrays, names):
+            if name is None or not hasattr(pa, "get") or not hasattr(pa, "permute"):
+                raise TypeError(f"NeighbourSearch: {pa!r} is not a ParticleArray")
+        if len(set(names)) != len(names):
+            raise ValueError(f"NeighbourSearch: array names must be distinct, got {names}")
+        if dim not in (1, 2, 3):
+            raise ValueError(f"NeighbourSearch: dim must be 1, 2 or 3, got {dim!r}")
+        radius_scale = float(radius_scale)
+        if not (math.isfinite(radius_scale) and radius_scale > 0):
+            raise ValueError(f"NeighbourSearch: radius_scale must be positive, got {radius_scale}")
+        domain = Domain() if domain is None else domain
+        if not isinstance(domain, Domain):
+            raise TypeError(f"NeighbourSearch: domain must be a Domain or None, got {domain!r}")
+        for a in range(dim, 3):
+            if domain.periodic[a]:
+                raise ValueError(f"NeighbourSearch: the domain is periodic in {_AXES[a]} but "
+                                 f"dim={dim} (only the first {dim} coordinates count)")
+        self.arrays = arrays
+        self.dim = int(dim)
+        self.radius_scale = radius_scale
+        self.domain = domain
+        self.n_updates = 0
+        self._by_name = dict(zip(names, arrays))
+        self._cache = {}
+        self._frozen = {}
+        self._bins = {}
+        self._sizes = {}
+        self._rank_key = None
+        self._rank = None
+        self.grid = None
+        self.cell_size = None    # (3,) cell edge per axis of the current grid
+        self.n_cells = None      # (3,) cells per axis of the current grid
+        self._build()
+        if sort:
+            self.sort()
+
+    # ------------------------------------------------------------ lookup
+    def _array(self, key):
+        """The ParticleArray named ``key`` (or ``key`` itself if it is one of ours)."""
+        if isinstance(key, str):
+            try:
+                return self._by_name[key]
+            except KeyError:
+                raise KeyError(f"NeighbourSearch has no array '{key}' "
+                               f"(arrays: {', '.join(self._by_name)})") from None
+        for pa in self.arrays:
+            if pa is key:
+                return pa
+        raise KeyError(f"NeighbourSearch: {key!r} is not one of its arrays "
+                       f"({', '.join(self._by_name)})")
+
+    def _coords(self, pa):
+        """[x, y, z] float64 arrays of ``pa`` (axes past ``dim`` repeat ``x``, unread)."""
+        xs = [pa.get(_AXES[a]) for a in range(self.dim)]
+        return xs + [xs[0]] * (3 - self.dim)
+
+    # ------------------------------------------------------------ building
+    def update(self):
+        """Wrap positions into the periodic box (in place, periodic axes only),
+        rebuild the cell lists and drop the cached neighbour lists."""
+        self._build()
+        self.n_updates += 1
+
+    def _build(self):
+        dom, dim = self.domain, self.dim
+        lo = [math.inf] * 3
+        hi = [-math.inf] * 3
+        hmax, ntotal = 0.0, 0
+        for pa in self.arrays:
+            ntotal += pa.n
+            for a in range(dim):
+                x = self._checked(pa, _AXES[a])
+                if dom.periodic[a]:
+                    bad = wrap_periodic(x, dom.lo[a], dom.length[a])
+                    if bad >= 0:
+                        self._non_finite(pa, _AXES[a], bad)
+                else:
+                    mn, mx, bad = scan(x)
+                    if bad >= 0:
+                        self._non_finite(pa, _AXES[a], bad)
+                    lo[a], hi[a] = min(lo[a], mn), max(hi[a], mx)
+            h = self._checked(pa, "h")
+            hmn, hmx, bad = scan(h)
+            if bad >= 0:
+                self._non_finite(pa, "h", bad)
+            if pa.n and hmn <= 0.0:
+                i = int(np.flatnonzero(h <= 0.0)[0])
+                raise ValueError(f"array '{pa.name}': particle {i} has h = {h[i]}; "
+                                 "the neighbour search needs h > 0")
+            hmax = max(hmax, hmx)
+        if ntotal == 0:
+            hmax = 1.0
+        cutoff = self.radius_scale * hmax
+        for a in range(dim):
+            if dom.periodic[a] and dom.length[a] < 2.0 * cutoff:
+                raise ValueError(
+                    f"periodic {_AXES[a]}-length {dom.length[a]} is less than twice the "
+                    f"largest cut-off radius_scale*max(h) = {cutoff}: the minimum image is "
+                    "not unique (enlarge the box or reduce h)")
+        self._make_grid(lo, hi, cutoff * _CELL_MARGIN, ntotal)
+        self._bins = {}
+        self._sizes = {}
+        for pa in self.arrays:
+            self._bins[pa.name] = bin_particles(self.grid, self._coords(pa), pa.get("h"))
+            self._sizes[pa.name] = pa.n
+        self._cache = {}
+
+    def _checked(self, pa, prop):
+        """The float64 contiguous array of ``prop`` with ``pa.n`` entries."""
+        arr = pa.get(prop)
+        if (not isinstance(arr, np.ndarray) or arr.dtype != np.float64 or arr.ndim != 1
+                or not arr.flags.c_contiguous or arr.size != pa.n):
+            raise ValueError(f"array '{pa.name}': property '{prop}' must be a contiguous "
+                             f"float64 array of {pa.n} values for the neighbour search")
+        return arr
+
+    @staticmethod
+    def _non_finite(pa, prop, i):
+        raise ValueError(f"array '{pa.name}': particle {i} has a non-finite {prop} "
+                         f"({pa.get(prop)[i]}); the neighbour search needs finite values")
+
+    def _make_grid(self, lo, hi, cell, ntotal):
+        """Choose the grid: cells of edge ``>= cell`` (periodic axes: L/n exactly),
+        anchored at multiples of the edge on open axes; coarsened if the cells would
+        far outnumber the particles (a few particles far away)."""
+        dom, dim = self.domain, self.dim
+        limit = max(8 * ntotal, 4096)
+        while True:
+            g_lo, g_cs, g_len, g_n = [0.0] * 3, [1.0] * 3, [0.0] * 3, [1] * 3
+            for a in range(dim):
+                if dom.periodic[a]:
+                    n = max(1, int(dom.length[a] / cell))
+                    g_lo[a], g_cs[a], g_len[a], g_n[a] = dom.lo[a], dom.length[a] / n, dom.length[a], n
+                elif lo[a] <= hi[a]:
+                    start = math.floor(lo[a] / cell) * cell
+                    g_lo[a], g_cs[a] = start, cell
+                    g_n[a] = int((hi[a] - start) / cell) + 1
+            if g_n[0] * g_n[1] * g_n[2] <= limit:
+                break
+            cell *= 2.0
+        key = (tuple(g_n), dim)
+        if key != self._rank_key:
+            self._rank = _morton_rank(g_n, dim)
+            self._rank_key = key
+        self.grid = GridSpec(dim, g_lo, g_cs, g_len, g_n,
+                             [int(p) for p in dom.periodic], self._rank)
+        self.cell_size = tuple(g_cs)
+        self.n_cells = tuple(g_n)
+
+    # ------------------------------------------------------------ queries
+    def neighbours(self, dest, src):
+        """``(offsets, nbrs)``: int32 CSR lists; ``nbrs[offsets[i]:offsets[i+1]]`` are
+        the indices j of ``src`` (ascending) with ``|r_ij| < k*max(h_i, h_j)``.
+
+        ``dest`` and ``src`` are array names or the arrays.  Computed on first use
+        after an update and cached: do not modify the returned arrays."""
+        d, s = self._array(dest), self._array(src)
+        key = (d.name, s.name)
+        lists = self._cache.get(key)
+        if lists is None:
+            for pa in (d, s):
+                if pa.n != self._sizes[pa.name]:
+                    raise RuntimeError(f"array '{pa.name}' has {pa.n} particles but had "
+                                       f"{self._sizes[pa.name]} at the last update(): call update()")
+            cell_start, cell_index = self._bins[s.name]
+            lists = build_csr(self.grid, self._coords(d), d.get("h"), self._coords(s),
+                              s.get("h"), cell_start, cell_index, self.radius_scale)
+            self._cache[key] = lists
+        return lists
+
+    def freeze(self, dest, src):
+        """Keep the current lists of (dest, src) as the fixed reference list (Total
+        Lagrangian SPH); they survive update() and are remapped by sort()."""
+        d, s = self._array(dest), self._array(src)
+        offsets, nbrs = self.neighbours(d, s)
+        self._frozen[(d.name, s.name)] = (offsets.copy(), nbrs.copy())
+
+    def reference_neighbours(self, dest, src):
+        """``(offsets, nbrs)`` of the list frozen by :meth:`freeze`."""
+        d, s = self._array(dest), self._array(src)
+        try:
+            return self._frozen[(d.name, s.name)]
+        except KeyError:
+            frozen = ", ".join(f"{a}<-{b}" for a, b in self._frozen) or "none"
+            raise NotFrozenError(
+                f"no reference neighbour list for dest '{d.name}', src '{s.name}': call "
+                f"freeze('{d.name}', '{s.name}') first (frozen: {frozen})") from None
+
+    def is_frozen(self, dest, src):
+        d, s = self._array(dest), self._array(src)
+        return (d.name, s.name) in self._frozen
+
+    # ------------------------------------------------------------ sorting
+    def sort(self):
+        """Spatially sort every array (particles of one cell contiguous, cells in
+        Morton order) with ``pa.permute(perm)``, remap the frozen reference lists
+        and rebuild.  Returns ``{name: perm}`` with ``new[k] = old[perm[k]]``."""
+        self._build()
+        perms = {}
+        inverse = {}
+        for pa in self.arrays:
+            perm = self._bins[pa.name][1].copy()
+            inv = np.empty_like(perm)
+            inv[perm] = np.arange(perm.size, dtype=perm.dtype)
+            pa.permute(perm)
+            perms[pa.name], inverse[pa.name] = perm, inv
+        for (d, s), (offsets, nbrs) in list(self._frozen.items()):
+            self._frozen[(d, s)] = remap_csr(offsets, nbrs, perms[d], inverse[s])
+        self._build()
+        return perms
