@@ -89,7 +89,7 @@ class Scene:
                 if gp.group.reference:
                     for dest in gp.dests:
                         for src in gp.sources(dest):
-                            if (dest, src) not in self.nnps.frozen:
+                            if not self.nnps.is_frozen(dest, src):
                                 self.nnps.freeze(dest, src)
 
     def _bind_neighbours(self):

@@ -138,7 +138,7 @@ def _origin_of_pyx_line(lines, lineno):
         ln = lines[i].strip()
         if src is None and ln.startswith("# @src "):
             src = ln[len("# @src "):]
-        m = re.match(r"cdef (?:inline )?\w+\*? (\w+)\(", ln)
+        m = re.match(r"(?:cdef (?:inline )?\w+\*? |def )(\w+)\(", ln)
         if m:
             func = m.group(1)
             break

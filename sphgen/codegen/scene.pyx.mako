@@ -3,6 +3,7 @@
 # Every function called inside a parallel loop is ``noexcept nogil``.
 from libc.math cimport *
 cimport numpy as cnp
+import numpy as np
 from cython.parallel cimport prange
 cnp.import_array()
 
@@ -122,7 +123,7 @@ def bind_arrays(dict arrays):
     ${arr}_n = n
 % for prop, ctype in props:
     a = d['${prop}']
-    if a.dtype != ${'cnp.float64' if ctype == 'double' else 'cnp.int32'} or a.size < n:
+    if a.dtype != ${'np.float64' if ctype == 'double' else 'np.int32'} or a.size < n:
         raise TypeError("${arr}.${prop}: expected ${ctype} data of at least %d values" % n)
     ${arr}_${prop} = <${ctype}*>_ptr(a, '${arr}.${prop}')
 % endfor
