@@ -8,6 +8,8 @@ user can step through a new equation with a debugger.
 import inspect
 import math
 
+import numpy as np
+
 from .equation import PAIR_METHODS
 
 
@@ -18,6 +20,7 @@ class PythonEvaluator:
         self.arrays = plan.arrays
         self.kernel = plan.kernel
         self._sig = {}
+        self._scratch = {}
 
     def _args(self, func):
         if func not in self._sig:
@@ -25,7 +28,15 @@ class PythonEvaluator:
         return self._sig[func]
 
     def _props(self, pa, name):
-        return pa.data[name] if name in pa.data else pa.constants[name]
+        if name in pa.data:
+            return pa.data[name]
+        if name in pa.constants:
+            return pa.constants[name]
+        # a store the generator removed as dead: give it scratch memory
+        key = (pa.name, name)
+        if key not in self._scratch:
+            self._scratch[key] = np.zeros(pa.n * pa.props[name].stride, dtype=pa.props[name].np_dtype)
+        return self._scratch[key]
 
     def _kwargs(self, func, dest, src, d_idx, s_idx, sym, t, dt, nbrs=None):
         kw = {}

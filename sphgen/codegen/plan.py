@@ -126,8 +126,20 @@ class Plan:
                 gps.append(eps)
             self.groups.append(list(zip(groups, gps)))
         self.steppers = [StepperPlan(a, s, i) for i, (a, s) in enumerate(sorted(steppers.items()))]
-        self._specialise()
-        self._prune()
+        dead = {}
+        while True:
+            self._specialise(dead)
+            self._prune()
+            new = {}
+            for ep in self.eqplans:
+                if ep.kept:
+                    d = {f"d_{p}" for a, p in ep.writes() if (a, p) not in self.needed}
+                    if d:
+                        new[id(ep.eq)] = d | dead.get(id(ep.eq), set())
+            if all(new.get(k, set()) <= dead.get(k, set()) for k in new):
+                break
+            for k, v in new.items():
+                dead[k] = dead.get(k, set()) | v
         self._check_properties()
         self.group_plans = []
         gi = 0
@@ -158,12 +170,13 @@ class Plan:
     def eqplans(self):
         return list(self._eqplans.values())
 
-    def _specialise(self):
+    def _specialise(self, dead):
         for ep in self.eqplans:
+            ep.kept, ep.reason, ep.methods = True, "", {}
             consts = {k: getattr(ep.eq, k) for k in ep.eq.switches}
             for m in ep.eq.methods():
                 try:
-                    sp = specialise(ep.eq, m, consts, ep.prefix)
+                    sp = specialise(ep.eq, m, consts, ep.prefix, dim=self.dim, dead=dead.get(id(ep.eq), ()))
                 except TranslationError as e:
                     raise SceneError(f"{ep.name}.{m}: {e}") from None
                 if m in PAIR_METHODS and any(w.startswith("s_") for w in sp.writes):
@@ -175,11 +188,16 @@ class Plan:
             if not ep.methods and not ep.python_hooks:
                 ep.kept = False
                 sw = ", ".join(f"{k}={getattr(ep.eq, k)!r}" for k in ep.eq.switches)
-                ep.reason = f"switched off ({sw})" if sw else "has no work"
+                if dead.get(id(ep.eq)):
+                    ep.reason = ("nothing reads what it writes (" +
+                                 ", ".join(sorted(d[2:] for d in dead[id(ep.eq)])) + ")")
+                else:
+                    ep.reason = f"switched off ({sw})" if sw else "has no work"
         for st in self.steppers:
+            st.stages = {}
             consts = {k: getattr(st.stepper, k) for k in getattr(st.stepper, "switches", ())}
             for m in st.stepper.stage_methods():
-                sp = specialise(st.stepper, m, consts, st.prefix)
+                sp = specialise(st.stepper, m, consts, st.prefix, dim=self.dim)
                 if not sp.empty:
                     st.stages[m] = sp
 
@@ -192,7 +210,7 @@ class Plan:
         for arr, props in self.outputs.items():
             needed |= {(arr, p) for p in props}
         for name in self.arrays:
-            needed |= {(name, p) for p in POSITION + ("h",)}
+            needed |= {(name, p) for p in POSITION[:self.dim] + ("h",)}
         live = {id(ep.eq) for ep in self.eqplans if ep.kept and (ep.python_hooks or ep.eq.keep)}
         changed = True
         while changed:

@@ -35,7 +35,8 @@ def _const_value(node):
 class _Specialiser(ast.NodeTransformer):
     """Fold switches, rename params, prune constant branches."""
 
-    def __init__(self, constants, param_names, prefix, methods=()):
+    def __init__(self, constants, param_names, prefix, methods=(), dim=3):
+        self.dim = dim
         self.methods = set(methods)
         self.constants = constants
         self.param_names = param_names
@@ -59,6 +60,22 @@ class _Specialiser(ast.NodeTransformer):
             raise TranslationError(f"self.{node.attr} is not a parameter of this object")
         return node
 
+    def visit_Subscript(self, node):
+        self.generic_visit(node)
+        # vector pair symbols have zero components beyond the scene's dimension
+        if isinstance(node.value, ast.Name) and node.value.id in VECTOR_SYMBOLS and \
+                isinstance(node.ctx, ast.Load) and isinstance(node.slice, ast.Constant) and \
+                isinstance(node.slice.value, int) and node.slice.value >= self.dim:
+            return ast.copy_location(ast.Constant(0.0), node)
+        return node
+
+    def visit_AugAssign(self, node):
+        self.generic_visit(node)
+        if isinstance(node.op, (ast.Add, ast.Sub)) and _const_value(node.value) == 0.0 \
+                and isinstance(node.value, ast.Constant):
+            return None
+        return node
+
     def visit_UnaryOp(self, node):
         self.generic_visit(node)
         v = _const_value(node.operand)
@@ -71,6 +88,13 @@ class _Specialiser(ast.NodeTransformer):
 
     def visit_BinOp(self, node):
         self.generic_visit(node)
+        zero = lambda n: isinstance(n, ast.Constant) and not isinstance(n.value, bool) and n.value == 0  # noqa: E731
+        if isinstance(node.op, ast.Mult) and (zero(node.left) or zero(node.right)):
+            return ast.copy_location(ast.Constant(0.0), node)
+        if isinstance(node.op, (ast.Add, ast.Sub)) and zero(node.right):
+            return node.left
+        if isinstance(node.op, ast.Add) and zero(node.left):
+            return node.right
         if _const_value(node.left) is not None and _const_value(node.right) is not None:
             try:
                 return ast.copy_location(ast.Constant(eval(compile(ast.Expression(node), "", "eval"))), node)
@@ -115,6 +139,34 @@ class _Specialiser(ast.NodeTransformer):
         return node
 
 
+class _DeadStores(ast.NodeTransformer):
+    """Remove stores to properties nothing needs (``d_X[...] = ...`` for X in dead)."""
+
+    def __init__(self, dead):
+        self.dead = dead
+
+    def _target(self, t):
+        return isinstance(t, ast.Subscript) and isinstance(t.value, ast.Name) and t.value.id in self.dead
+
+    def visit_Assign(self, node):
+        return None if all(self._target(t) for t in node.targets) else node
+
+    def visit_AugAssign(self, node):
+        return None if self._target(node.target) else node
+
+    def visit_If(self, node):
+        self.generic_visit(node)
+        if not node.body and not node.orelse:
+            return None
+        if not node.body:
+            node.body = [ast.Pass()]
+        return node
+
+    def visit_For(self, node):
+        self.generic_visit(node)
+        return node if node.body else None
+
+
 def _names(tree):
     return {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)}
 
@@ -152,20 +204,15 @@ class Specialised:
 
 def _usage(fdef):
     """(reads, writes): sets of argument names read / written through subscripts."""
-    reads, writes = set(), set()
+    reads, writes, stored = set(), set(), set()
     for node in ast.walk(fdef):
-        if isinstance(node, ast.Subscript) and isinstance(node.value, ast.Name):
-            name = node.value.id
-            if isinstance(node.ctx, ast.Store):
-                writes.add(name)
-            else:
-                reads.add(name)
-        elif isinstance(node, ast.Name) and isinstance(node.ctx, ast.Load):
+        if isinstance(node, ast.Subscript) and isinstance(node.value, ast.Name) and \
+                isinstance(node.ctx, ast.Store):
+            writes.add(node.value.id)
+            stored.add(id(node.value))
+    for node in ast.walk(fdef):
+        if isinstance(node, ast.Name) and isinstance(node.ctx, ast.Load) and id(node) not in stored:
             reads.add(node.id)
-    for node in ast.walk(fdef):
-        if isinstance(node, ast.AugAssign) and isinstance(node.target, ast.Subscript):
-            # ``d_au[d_idx] += ...`` both reads and writes the property
-            reads.add(node.target.value.id)
     return reads, writes
 
 
@@ -178,7 +225,7 @@ def method_source(func):
     return textwrap.dedent("".join(lines)), inspect.getsourcefile(func) or "<unknown>", first
 
 
-def specialise(owner, method, constants, prefix, keep_defaults=False):
+def specialise(owner, method, constants, prefix, keep_defaults=False, dim=3, dead=()):
     """Specialise ``owner.method`` into a function named ``<prefix>_<method>``.
 
     ``constants`` are folded; other numeric attributes become globals ``<prefix>_<name>``.
@@ -201,8 +248,11 @@ def specialise(owner, method, constants, prefix, keep_defaults=False):
         fdef.args.defaults = fdef.args.defaults[-len(fdef.args.args):] if fdef.args.args else []
     numeric = {k for k, v in params.items() if isinstance(v, (int, float)) and k not in constants}
     methods = [m for m in dir(type(owner)) if not m.startswith("_") and callable(getattr(type(owner), m))]
-    sp = _Specialiser(constants, numeric, prefix, methods)
+    sp = _Specialiser(constants, numeric, prefix, methods, dim)
     fdef = sp.visit(fdef)
+    if dead:
+        fdef = _DeadStores(set(dead)).visit(fdef)
+        fdef = sp.visit(fdef)
     if not fdef.body:
         fdef.body = [ast.Pass()]
     _declare_loop_counters(fdef)

@@ -2,26 +2,40 @@
 # cython: initializedcheck=False, nonecheck=False
 """Cell-linked-list kernels of the neighbour search (compiled, OpenMP).
 
-The Python side (``sphgen.nnps.NeighbourSearch``) decides the grid; this module does
+The Python side (``sphgen.nnps.NeighbourSearch``) chooses the grid; this module does
 the per-particle work:
 
-* ``wrap_periodic`` / ``scan``: wrap coordinates into a periodic box, find bounds and
-  the first non-finite value;
-* ``bin_particles``: assign every particle to a cell and counting-sort the particle
-  indices by cell (``cell_start``/``cell_index``, a CSR of cells);
-* ``build_csr``: for every destination particle, the source particles closer than
-  ``k * max(h_i, h_j)`` (minimum image on periodic axes), as CSR int32 lists, built
-  in three steps: a parallel count pass, a prefix sum, a parallel fill pass;
+* ``wrap_periodic`` / ``scan``: wrap coordinates into a periodic box; bounds and the
+  first non-finite value of an array;
+* ``bin_particles``: put every particle in a cell and counting-sort the particles by
+  cell.  A bin is ``cell_start`` (CSR over cells), ``cell_index`` (particle indices
+  in cell order) and ``pts``, a copy of ``(x, y, z, h)`` in cell order (unused axes
+  zero) so that the distance loops read contiguous memory;
+* ``build_csr``: for every destination particle ``i``, the source particles ``j``
+  with ``|r_ij| < k * max(h_i, h_j)`` as int32 CSR lists.  Three steps:
+
+  1. parallel *count pass* over blocks of destination cells: each block scans its
+     particles and keeps their rows in a private buffer (so every distance is
+     computed once), recording the count of each row;
+  2. prefix sum of the counts -> ``offsets``;
+  3. parallel *fill pass*: each block copies its rows to ``nbrs[offsets[i]:]``.
+
 * ``remap_csr``: rewrite a CSR list after both arrays were permuted.
 
-Cells are stored in *rank* order (the grid's linear index ``ix + nx*(iy + ny*iz)``
-is mapped through ``rank``, a Morton/Z-order ranking chosen in Python), so particles
-binned by rank are in a cache-friendly order, and a spatial sort is simply the
-``cell_index`` permutation.  Neighbour cells are visited in ascending rank, so after a
-sort the rows come out already ascending; otherwise each row is sorted.
+Cells are stored in *rank* order: the linear grid index ``ix + nx*(iy + ny*iz)`` is
+mapped through ``rank`` (a Morton/Z-order ranking chosen in Python), so particles
+binned by rank are in a cache-friendly order and a spatial sort is the
+``cell_index`` permutation.  Neighbour cells are visited in ascending rank, so rows of
+a sorted source come out ascending; otherwise each row is sorted.
+
+Periodic axes with at least 3 cells use one image shift per neighbour cell (the
+minimum image, computed as ``(x_i - x_j) -/+ L`` like the usual formula); an axis
+with fewer cells visits every cell once and takes the minimum image pair by pair.
 """
 from cython.parallel cimport prange
 from libc.math cimport floor, isfinite
+from libc.stdlib cimport free, malloc, realloc
+from libc.string cimport memcpy
 
 import numpy as np
 
@@ -34,34 +48,49 @@ ctypedef struct Grid:
     double length[3]     # box length along periodic axes
     double half[3]       # length / 2
     int n[3]             # cells along each axis (1 for unused axes)
-    int periodic[3]      # 1 if the axis is periodic (minimum image)
-    int all_cells[3]     # periodic axis with < 3 cells: visit every cell once
+    int periodic[3]      # 1 if the axis is periodic
+    int all_cells[3]     # periodic axis with < 3 cells: visit every cell, pair image
+    int any_all_cells    # some axis has all_cells
     const int* rank      # linear cell index -> storage rank
+    const int* unrank    # storage rank -> linear cell index
 
 
-ctypedef struct Points:
-    const double* x[3]   # coordinates (unused axes point at x[0], never read)
-    const double* h      # smoothing lengths
+ctypedef struct Bins:
+    const int* start     # cell_start, ncells + 1 entries
+    const int* index     # particle index at each cell-order position
+    const double* pts    # (x, y, z, h) at each cell-order position
     Py_ssize_t n
+
+
+ctypedef struct Row:
+    int* data            # growable buffer of one block of rows
+    Py_ssize_t used
+    Py_ssize_t cap
 
 
 cdef class GridSpec:
     """The cell grid shared by all arrays of one neighbour search.
 
-    Parameters are length-3 sequences (unused axes: ``n = 1``); ``rank`` is an
+    ``lo``, ``cs`` (cell edges), ``length`` (periodic box lengths), ``n`` (cells) and
+    ``periodic`` are length-3 sequences (unused axes: ``n = 1``); ``rank`` is an
     int32 array of ``prod(n)`` entries, the storage rank of each linear cell index.
     """
     cdef Grid c
     cdef int[::1] _rank
+    cdef int[::1] _unrank
     cdef readonly Py_ssize_t ncells
 
     def __init__(self, int dim, lo, cs, length, n, periodic, int[::1] rank):
         cdef int a
+        cdef Py_ssize_t i
         if dim < 1 or dim > 3:
             raise ValueError(f"dim must be 1, 2 or 3, got {dim}")
         self.c.dim = dim
+        self.c.any_all_cells = 0
         self.ncells = 1
         for a in range(3):
+            if n[a] < 1 or not (cs[a] > 0.0):
+                raise ValueError(f"axis {a}: need n >= 1 and cell size > 0")
             self.c.lo[a] = lo[a]
             self.c.cs[a] = cs[a]
             self.c.length[a] = length[a]
@@ -69,28 +98,28 @@ cdef class GridSpec:
             self.c.n[a] = n[a]
             self.c.periodic[a] = 1 if (periodic[a] and a < dim) else 0
             self.c.all_cells[a] = 1 if (self.c.periodic[a] and n[a] < 3) else 0
-            if n[a] < 1 or not (cs[a] > 0.0):
-                raise ValueError(f"axis {a}: need n >= 1 and cell size > 0")
+            self.c.any_all_cells |= self.c.all_cells[a]
             self.ncells *= n[a]
         if rank.shape[0] != self.ncells:
             raise ValueError(f"rank has {rank.shape[0]} entries, the grid {self.ncells} cells")
         self._rank = rank
+        self._unrank = np.empty(self.ncells, dtype=np.int32)
+        for i in range(self.ncells):
+            self._unrank[rank[i]] = <int>i
         self.c.rank = &self._rank[0]
+        self.c.unrank = &self._unrank[0]
 
 
-cdef Points _points(list coords, double[::1] h) except *:
-    """Points view of coordinate arrays (``coords`` has 3 entries) and ``h``."""
-    cdef Points p
-    cdef double[::1] xa
-    cdef int a
-    p.n = h.shape[0]
-    for a in range(3):
-        xa = coords[a]
-        if xa.shape[0] != p.n:
-            raise ValueError(f"coordinate {a} has {xa.shape[0]} values, h has {p.n}")
-        p.x[a] = &xa[0] if p.n > 0 else NULL
-    p.h = &h[0] if p.n > 0 else NULL
-    return p
+cdef Bins _bins(int[::1] cell_start, int[::1] cell_index, double[:, ::1] pts) except *:
+    """C view of one array's bins (checks the shapes agree)."""
+    cdef Bins b
+    b.n = cell_index.shape[0]
+    if pts.shape[0] != b.n or pts.shape[1] != 4 or cell_start.shape[0] < 2:
+        raise ValueError("inconsistent bins: cell_index, pts (n, 4) and cell_start disagree")
+    b.start = &cell_start[0]
+    b.index = &cell_index[0] if b.n > 0 else NULL
+    b.pts = &pts[0, 0] if b.n > 0 else NULL
+    return b
 
 
 cdef inline int* _iptr(int[::1] v) noexcept:
@@ -102,7 +131,6 @@ cdef inline int* _iptr(int[::1] v) noexcept:
 cdef inline int _cell_coord(const Grid* g, int a, double x) noexcept nogil:
     """Cell coordinate of ``x`` along axis ``a``, clamped into the grid."""
     cdef double t
-    cdef int c
     if a >= g.dim:
         return 0
     t = floor((x - g.lo[a]) / g.cs[a])
@@ -110,8 +138,7 @@ cdef inline int _cell_coord(const Grid* g, int a, double x) noexcept nogil:
         return 0
     if t >= g.n[a] - 1:
         return g.n[a] - 1
-    c = <int>t
-    return c
+    return <int>t
 
 
 cdef inline double _min_image(const Grid* g, int a, double d) noexcept nogil:
@@ -123,29 +150,79 @@ cdef inline double _min_image(const Grid* g, int a, double d) noexcept nogil:
     return d
 
 
-cdef int _axis_candidates(const Grid* g, int a, int c, int* out) noexcept nogil:
-    """Distinct cell coordinates along axis ``a`` that may hold neighbours of cell ``c``."""
+cdef int _axis_candidates(const Grid* g, int a, int c, int* out,
+                          double* shift) noexcept nogil:
+    """Distinct cell coordinates along axis ``a`` that may hold neighbours of cell
+    ``c``, with the image shift to add to ``x_i - x_j`` for each; returns the count."""
     cdef int m = 0, k, q
+    cdef double s
     if a >= g.dim:
         out[0] = 0
+        shift[0] = 0.0
         return 1
-    if g.all_cells[a]:
+    if g.all_cells[a]:          # pair-by-pair minimum image instead of a shift
         for k in range(g.n[a]):
             out[k] = k
+            shift[k] = 0.0
         return g.n[a]
     for k in range(-1, 2):
         q = c + k
-        if g.periodic[a]:
-            if q < 0:
-                q += g.n[a]
-            elif q >= g.n[a]:
-                q -= g.n[a]
-        elif q < 0 or q >= g.n[a]:
-            continue
+        s = 0.0
+        if q < 0:
+            if not g.periodic[a]:
+                continue
+            q += g.n[a]
+            s = g.length[a]     # the cell's particles are seen at x - L
+        elif q >= g.n[a]:
+            if not g.periodic[a]:
+                continue
+            q -= g.n[a]
+            s = -g.length[a]    # ... at x + L
         out[m] = q
+        shift[m] = s
         m += 1
     return m
 
+
+cdef int _neighbour_cells(const Grid* g, int rank, int* cells,
+                          double* shifts) noexcept nogil:
+    """Ranks of the (at most 27, distinct) cells around the cell of rank ``rank``,
+    ascending, and their image shifts (``shifts[3*m + a]``); returns their number."""
+    cdef int cand[3][3]
+    cdef double sh[3][3]
+    cdef int m[3]
+    cdef int c[3]
+    cdef int a, p, q, r, u, nc = 0, lin = g.unrank[rank]
+    cdef double s0, s1, s2
+    c[0] = lin % g.n[0]
+    c[1] = (lin // g.n[0]) % g.n[1]
+    c[2] = lin // (g.n[0] * g.n[1])
+    for a in range(3):
+        m[a] = _axis_candidates(g, a, c[a], cand[a], sh[a])
+    for r in range(m[2]):
+        for q in range(m[1]):
+            for p in range(m[0]):
+                cells[nc] = g.rank[cand[0][p] + g.n[0] * (cand[1][q] + g.n[1] * cand[2][r])]
+                shifts[3 * nc] = sh[0][p]
+                shifts[3 * nc + 1] = sh[1][q]
+                shifts[3 * nc + 2] = sh[2][r]
+                nc += 1
+    # insertion sort by rank, carrying the shifts along
+    for p in range(1, nc):
+        u = cells[p]
+        s0, s1, s2 = shifts[3 * p], shifts[3 * p + 1], shifts[3 * p + 2]
+        q = p - 1
+        while q >= 0 and cells[q] > u:
+            cells[q + 1] = cells[q]
+            shifts[3 * q + 3] = shifts[3 * q]
+            shifts[3 * q + 4] = shifts[3 * q + 1]
+            shifts[3 * q + 5] = shifts[3 * q + 2]
+            q -= 1
+        cells[q + 1] = u
+        shifts[3 * q + 3], shifts[3 * q + 4], shifts[3 * q + 5] = s0, s1, s2
+    return nc
+
+# ----------------------------------------------------------------- row sorting
 
 cdef void _insertion_sort(int* v, Py_ssize_t n) noexcept nogil:
     cdef Py_ssize_t i, j
@@ -176,13 +253,11 @@ cdef void _sift_down(int* v, Py_ssize_t root, Py_ssize_t end) noexcept nogil:
 
 
 cdef void _heap_sort(int* v, Py_ssize_t n) noexcept nogil:
-    cdef Py_ssize_t start, end
+    cdef Py_ssize_t start = n // 2 - 1, end = n - 1
     cdef int tmp
-    start = n // 2 - 1
     while start >= 0:
         _sift_down(v, start, n)
         start -= 1
-    end = n - 1
     while end > 0:
         tmp = v[0]
         v[0] = v[end]
@@ -196,63 +271,123 @@ cdef void _sort_row(int* v, Py_ssize_t n) noexcept nogil:
     cdef Py_ssize_t i
     for i in range(1, n):
         if v[i] < v[i - 1]:
-            break
-    else:
-        return
-    if n <= 32:
-        _insertion_sort(v, n)
-    else:
-        _heap_sort(v, n)
+            if n <= 32:
+                _insertion_sort(v, n)
+            else:
+                _heap_sort(v, n)
+            return
+
+# ------------------------------------------------------------ scanning cells
+
+cdef Py_ssize_t _scan_cell(const double* xi, double k, const Bins* s, int cell,
+                           const double* shift, int* out) noexcept nogil:
+    """Append to ``out`` the sources of ``cell`` within reach of ``xi`` = (x, y, z, h),
+    the cell seen through the image ``shift``; returns how many.  Branch-free: ``out``
+    must have room for every particle of the cell."""
+    cdef Py_ssize_t p, cnt = 0
+    cdef const double* q
+    cdef double dx, dy, dz, hj, rc, r2
+    cdef double x0 = xi[0] + shift[0], y0 = xi[1] + shift[1], z0 = xi[2] + shift[2]
+    cdef double hi = xi[3]
+    for p in range(s.start[cell], s.start[cell + 1]):
+        q = s.pts + 4 * p
+        dx = (xi[0] - q[0]) + shift[0]
+        dy = (xi[1] - q[1]) + shift[1]
+        dz = (xi[2] - q[2]) + shift[2]
+        hj = q[3]
+        rc = k * (hi if hi > hj else hj)
+        r2 = dx * dx + dy * dy + dz * dz
+        out[cnt] = s.index[p]
+        cnt += r2 < rc * rc
+    return cnt
 
 
-cdef int _neighbour_cells(const Grid* g, const Points* d, Py_ssize_t i,
-                          int* cells) noexcept nogil:
-    """Storage ranks of the (at most 27, distinct) cells around particle ``i`` of
-    ``d``, ascending; returns their number."""
-    cdef int cand[3][3]
-    cdef int m[3]
-    cdef int a, p, q, r, nc = 0
-    for a in range(3):
-        m[a] = _axis_candidates(g, a, _cell_coord(g, a, d.x[a][i]), cand[a])
-    for r in range(m[2]):
-        for q in range(m[1]):
-            for p in range(m[0]):
-                cells[nc] = g.rank[cand[0][p] + g.n[0] * (cand[1][q] + g.n[1] * cand[2][r])]
-                nc += 1
-    _insertion_sort(cells, nc)
-    return nc
+cdef Py_ssize_t _scan_cell_pair_image(const Grid* g, const double* xi, double k,
+                                      const Bins* s, int cell, const double* shift,
+                                      int* out) noexcept nogil:
+    """``_scan_cell`` for grids with a periodic axis of < 3 cells: the minimum image
+    is taken pair by pair on those axes."""
+    cdef Py_ssize_t p, cnt = 0
+    cdef const double* q
+    cdef double d[3]
+    cdef double hj, rc, r2, hi = xi[3]
+    cdef int a
+    for p in range(s.start[cell], s.start[cell + 1]):
+        q = s.pts + 4 * p
+        for a in range(3):
+            d[a] = (xi[a] - q[a]) + shift[a]
+            if g.all_cells[a]:
+                d[a] = _min_image(g, a, d[a])
+        hj = q[3]
+        rc = k * (hi if hi > hj else hj)
+        r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+        out[cnt] = s.index[p]
+        cnt += r2 < rc * rc
+    return cnt
 
 
-cdef Py_ssize_t _scan_row(const Grid* g, const Points* d, const Points* s,
-                          const int* cell_start, const int* cell_index,
-                          double k, Py_ssize_t i, int* out) noexcept nogil:
-    """Neighbours of destination particle ``i`` among the sources.
+cdef int _reserve(Row* buf, Py_ssize_t extra) noexcept nogil:
+    """Make room for ``extra`` more entries; 0 on success, -1 if out of memory."""
+    cdef Py_ssize_t cap
+    cdef int* data
+    if buf.used + extra <= buf.cap:
+        return 0
+    cap = 2 * buf.cap
+    if cap < buf.used + extra:
+        cap = buf.used + extra
+    data = <int*>realloc(buf.data, cap * sizeof(int))
+    if data == NULL:
+        return -1
+    buf.data = data
+    buf.cap = cap
+    return 0
 
-    Counts them, and writes their indices to ``out`` unless it is NULL."""
+
+cdef int _block_rows(const Grid* g, const Bins* d, const Bins* s, double k,
+                     int cell_lo, int cell_hi, int* counts, Row* buf) noexcept nogil:
+    """Count pass of one block of destination cells ``[cell_lo, cell_hi)``: the rows
+    of its particles (in cell order) go to ``buf``, their lengths to ``counts``.
+    Returns 0, or -1 if out of memory."""
     cdef int cells[27]
-    cdef int nc, c, a, j
-    cdef Py_ssize_t p, count = 0
-    cdef double xi[3]
-    cdef double hi = d.h[i], hj, dx, r2, rc
-    for a in range(g.dim):
-        xi[a] = d.x[a][i]
-    nc = _neighbour_cells(g, d, i, cells)
-    for c in range(nc):
-        for p in range(cell_start[cells[c]], cell_start[cells[c] + 1]):
-            j = cell_index[p]
-            r2 = 0.0
-            for a in range(g.dim):
-                dx = xi[a] - s.x[a][j]
-                if g.periodic[a]:
-                    dx = _min_image(g, a, dx)
-                r2 = r2 + dx * dx
-            hj = s.h[j]
-            rc = k * (hi if hi > hj else hj)
-            if r2 < rc * rc:
-                if out != NULL:
-                    out[count] = j
-                count = count + 1
-    return count
+    cdef double shifts[81]
+    cdef int nc, c, r, i
+    cdef Py_ssize_t p, upper, cnt
+    for r in range(cell_lo, cell_hi):
+        if d.start[r] == d.start[r + 1]:
+            continue
+        nc = _neighbour_cells(g, r, cells, shifts)
+        upper = 0
+        for c in range(nc):
+            upper += s.start[cells[c] + 1] - s.start[cells[c]]
+        for p in range(d.start[r], d.start[r + 1]):
+            if _reserve(buf, upper) != 0:
+                return -1
+            cnt = 0
+            for c in range(nc):
+                if g.any_all_cells:
+                    cnt += _scan_cell_pair_image(g, d.pts + 4 * p, k, s, cells[c],
+                                                 shifts + 3 * c, buf.data + buf.used + cnt)
+                else:
+                    cnt += _scan_cell(d.pts + 4 * p, k, s, cells[c], shifts + 3 * c,
+                                      buf.data + buf.used + cnt)
+            _sort_row(buf.data + buf.used, cnt)
+            i = d.index[p]
+            counts[i] = <int>cnt
+            buf.used += cnt
+    return 0
+
+
+cdef void _block_fill(const Bins* d, int cell_lo, int cell_hi, const int* offsets,
+                      const Row* buf, int* nbrs) noexcept nogil:
+    """Fill pass of one block: copy its rows from ``buf`` to their CSR place."""
+    cdef Py_ssize_t p, pos = 0, cnt
+    cdef int i
+    for p in range(d.start[cell_lo], d.start[cell_hi]):
+        i = d.index[p]
+        cnt = offsets[i + 1] - offsets[i]
+        if cnt > 0:
+            memcpy(nbrs + offsets[i], buf.data + pos, cnt * sizeof(int))
+        pos += cnt
 
 
 cdef int _prefix_sum(const int* counts, Py_ssize_t n, int[::1] offsets) except -1:
@@ -267,6 +402,25 @@ cdef int _prefix_sum(const int* counts, Py_ssize_t n, int[::1] offsets) except -
                                 "hold them (reduce the particle count or the support radius)")
         offsets[i + 1] = <int>total
     return 0
+
+
+cdef Py_ssize_t _make_blocks(const Bins* d, Py_ssize_t ncells, Py_ssize_t target,
+                             int[::1] bounds):
+    """Split the destination cells into consecutive blocks of about ``target``
+    particles; ``bounds[b]:bounds[b+1]`` are the cells of block ``b``.  Returns the
+    number of blocks (``bounds`` needs ``ncells + 1`` entries)."""
+    cdef Py_ssize_t r, nb = 0, acc = 0
+    bounds[0] = 0
+    for r in range(ncells):
+        acc += d.start[r + 1] - d.start[r]
+        if acc >= target:
+            nb += 1
+            bounds[nb] = <int>(r + 1)
+            acc = 0
+    if bounds[nb] != ncells:
+        nb += 1
+        bounds[nb] = <int>ncells
+    return nb
 
 # ------------------------------------------------------------- Python API
 
@@ -283,9 +437,7 @@ def wrap_periodic(double[::1] x, double lo, double length):
             return i
         if v < lo or v >= hi:
             v = v - length * floor((v - lo) / length)
-            if v >= hi:          # rounding of a value just below lo
-                v = lo
-            elif v < lo:
+            if v >= hi or v < lo:    # rounding of a value a hair below lo
                 v = lo
             x[i] = v
     return -1
@@ -307,22 +459,31 @@ def scan(double[::1] x):
 
 
 def bin_particles(GridSpec grid, list coords, double[::1] h):
-    """Bin particles into the grid's cells (counting sort, stable).
+    """Bin particles into the grid's cells (stable counting sort).
 
-    Returns ``(cell_start, cell_index)``, int32: the particles of the cell of rank
-    ``r`` are ``cell_index[cell_start[r]:cell_start[r+1]]``, ascending."""
-    cdef Points pts = _points(coords, h)
+    ``coords`` holds the x, y, z arrays (entries past ``dim`` are not read).
+    Returns ``(cell_start, cell_index, pts)``: the particles of the cell of rank ``r``
+    are ``cell_index[cell_start[r]:cell_start[r+1]]`` (ascending) and ``pts[p]`` is
+    ``(x, y, z, h)`` of particle ``cell_index[p]`` (unused axes 0)."""
     cdef const Grid* g = &grid.c
-    cdef Py_ssize_t n = pts.n, ncells = grid.ncells, i
+    cdef Py_ssize_t n = h.shape[0], ncells = grid.ncells, i, p
     cdef int a, c, lin
+    cdef const double* x[3]
+    cdef double[::1] xa
     cdef int[::1] cell_of = np.empty(n, dtype=np.int32)
     cdef int[::1] cell_start = np.zeros(ncells + 1, dtype=np.int32)
     cdef int[::1] cell_index = np.empty(n, dtype=np.int32)
     cdef int[::1] fill
+    cdef double[:, ::1] pts = np.zeros((n, 4), dtype=np.float64)
+    for a in range(g.dim):
+        xa = coords[a]
+        if xa.shape[0] != n:
+            raise ValueError(f"coordinate {a} has {xa.shape[0]} values, h has {n}")
+        x[a] = &xa[0] if n > 0 else NULL
     for i in prange(n, nogil=True, schedule="static"):
         lin = 0
-        for a in range(2, -1, -1):
-            lin = lin * g.n[a] + _cell_coord(g, a, pts.x[a][i])
+        for a in range(g.dim - 1, -1, -1):
+            lin = lin * g.n[a] + _cell_coord(g, a, x[a][i])
         cell_of[i] = g.rank[lin]
     for i in range(n):
         cell_start[cell_of[i] + 1] += 1
@@ -333,37 +494,57 @@ def bin_particles(GridSpec grid, list coords, double[::1] h):
         c = cell_of[i]
         cell_index[fill[c]] = <int>i
         fill[c] += 1
-    return np.asarray(cell_start), np.asarray(cell_index)
+    for p in prange(n, nogil=True, schedule="static"):
+        i = cell_index[p]
+        for a in range(g.dim):
+            pts[p, a] = x[a][i]
+        pts[p, 3] = h[i]
+    return np.asarray(cell_start), np.asarray(cell_index), np.asarray(pts)
 
 
-def build_csr(GridSpec grid, list dest_coords, double[::1] dest_h,
-              list src_coords, double[::1] src_h,
-              int[::1] cell_start, int[::1] cell_index, double radius_scale):
+def build_csr(GridSpec grid, dest_bins, src_bins, double radius_scale,
+              Py_ssize_t block_size=128):
     """CSR neighbour lists of every destination particle among the source particles.
 
-    ``cell_start``/``cell_index`` are the source's bins from ``bin_particles`` with
-    the same grid.  Returns ``(offsets, nbrs)``, int32, each row ascending."""
-    cdef Points d = _points(dest_coords, dest_h)
-    cdef Points s = _points(src_coords, src_h)
+    ``dest_bins``/``src_bins`` are ``bin_particles`` results on the same grid.
+    Returns ``(offsets, nbrs)``, int32, each row ascending."""
+    cdef Bins d = _bins(*dest_bins)
+    cdef Bins s = _bins(*src_bins)
     cdef const Grid* g = &grid.c
-    cdef Py_ssize_t nd = d.n, i, cnt
-    cdef int[::1] counts = np.empty(nd, dtype=np.int32)
+    cdef Py_ssize_t nd = d.n, ncells = grid.ncells, nb, b
+    cdef int[::1] counts = np.zeros(nd, dtype=np.int32)
     cdef int[::1] offsets = np.empty(nd + 1, dtype=np.int32)
+    cdef int[::1] bounds = np.empty(ncells + 1, dtype=np.int32)
     cdef int[::1] nbrs
     cdef int* pn
-    cdef const int* cst = _iptr(cell_start)
-    cdef const int* cix = _iptr(cell_index)
+    cdef Row* bufs
+    cdef int failed = 0
     cdef double k = radius_scale
-    if cell_start.shape[0] != grid.ncells + 1 or cell_index.shape[0] != s.n:
-        raise ValueError("source bins do not match the grid or the source array")
-    for i in prange(nd, nogil=True, schedule="guided"):
-        counts[i] = <int>_scan_row(g, &d, &s, cst, cix, k, i, NULL)
-    _prefix_sum(_iptr(counts), nd, offsets)
-    nbrs = np.empty(offsets[nd], dtype=np.int32)
-    pn = _iptr(nbrs)
-    for i in prange(nd, nogil=True, schedule="guided"):
-        cnt = _scan_row(g, &d, &s, cst, cix, k, i, pn + offsets[i])
-        _sort_row(pn + offsets[i], cnt)
+    if d.start == NULL or s.start == NULL:
+        raise ValueError("empty bins")
+    nb = _make_blocks(&d, ncells, block_size, bounds)
+    bufs = <Row*>malloc(nb * sizeof(Row))
+    if bufs == NULL:
+        raise MemoryError()
+    for b in range(nb):
+        bufs[b].data = NULL
+        bufs[b].used = 0
+        bufs[b].cap = 0
+    try:
+        for b in prange(nb, nogil=True, schedule="dynamic"):
+            if _block_rows(g, &d, &s, k, bounds[b], bounds[b + 1], _iptr(counts), &bufs[b]) != 0:
+                failed = 1
+        if failed:
+            raise MemoryError("out of memory while building neighbour lists")
+        _prefix_sum(_iptr(counts), nd, offsets)
+        nbrs = np.empty(offsets[nd], dtype=np.int32)
+        pn = _iptr(nbrs)
+        for b in prange(nb, nogil=True, schedule="static"):
+            _block_fill(&d, bounds[b], bounds[b + 1], &offsets[0], &bufs[b], pn)
+    finally:
+        for b in range(nb):
+            free(bufs[b].data)
+        free(bufs)
     return np.asarray(offsets), np.asarray(nbrs)
 
 

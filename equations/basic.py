@@ -1,0 +1,23 @@
+"""Density and simple per-particle equations shared by every scheme."""
+from sphgen.equation import Equation
+
+
+class SummationDensity(Equation):
+    """rho_a = sum_b m_b W_ab (seed 002 section 2.3, option 1)."""
+
+    def initialize(self, d_idx, d_rho):
+        d_rho[d_idx] = 0.0
+
+    def loop(self, d_idx, d_rho, s_idx, s_m, WIJ):
+        d_rho[d_idx] += s_m[s_idx] * WIJ
+
+
+class Vorticity2D(Equation):
+    """omega_a = -sum_b V_b (u_ab x grad W_ab)_z, a diagnostic for output only."""
+
+    def initialize(self, d_idx, d_omega):
+        d_omega[d_idx] = 0.0
+
+    def loop(self, d_idx, d_omega, s_idx, s_m, s_rho, VIJ, DWIJ):
+        vb = s_m[s_idx] / s_rho[s_idx]
+        d_omega[d_idx] += -vb * (VIJ[0] * DWIJ[1] - VIJ[1] * DWIJ[0])
