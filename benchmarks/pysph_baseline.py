@@ -24,6 +24,7 @@ from __future__ import annotations
 import csv
 import os
 import re
+import resource
 import subprocess
 import sys
 import tempfile
@@ -66,6 +67,27 @@ def _read_text(path: Path) -> str:
         return path.read_text(errors="replace")
     except OSError:
         return ""
+
+
+def _loadavg() -> float | None:
+    """1-minute load average (the machine may be shared), or None."""
+    try:
+        return os.getloadavg()[0]
+    except (AttributeError, OSError):
+        return None
+
+
+def _busy_cpu_seconds() -> float | None:
+    """Machine-wide busy CPU seconds so far (Linux /proc/stat), or None."""
+    try:
+        with open("/proc/stat") as f:
+            fields = f.readline().split()[1:]
+        ticks = [int(v) for v in fields]
+        idle = ticks[3] + (ticks[4] if len(ticks) > 4 else 0)  # idle + iowait
+        busy = sum(ticks[:8]) - idle  # guest time is already in user
+        return busy / os.sysconf("SC_CLK_TCK")
+    except (OSError, ValueError, IndexError):
+        return None
 
 
 def _read_profile(path: Path) -> dict:
@@ -131,6 +153,11 @@ def run_pysph(
     Returns a dict with keys: ``cmd``, ``returncode``, ``wall_s``,
     ``setup_s`` (PySPH "Setup took", includes code generation and compile
     when not cached), ``run_s`` (PySPH "Run took", the time loop only),
+    ``cpu_user_s``/``cpu_sys_s`` (child CPU time, whole process),
+    ``load_before``/``load_after`` (1-min load average; the machine may be
+    shared, so compare timings only at similar load), ``other_cpu_s``
+    (CPU seconds used by *other* processes on the machine during the run:
+    a direct contention measure; ~0 means the timing is clean),
     ``compiled`` (True if this run compiled its extension), ``n_real``
     (fluid particles), ``n_array`` (fluid + periodic ghosts in the array),
     ``dt``, ``steps``, ``accel_evals``, ``edac_nu``, ``profile`` (dict of
@@ -175,12 +202,22 @@ def run_pysph(
         home.mkdir(exist_ok=True)
         env["HOME"] = str(home)
 
+    load_before = _loadavg()
+    ru0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    busy0 = _busy_cpu_seconds()
     t0 = time.perf_counter()
     proc = subprocess.run(
         cmd, cwd=str(workdir), env=env, capture_output=True, text=True,
         timeout=timeout,
     )
     wall = time.perf_counter() - t0
+    ru1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    busy1 = _busy_cpu_seconds()
+    cpu_user = ru1.ru_utime - ru0.ru_utime
+    cpu_sys = ru1.ru_stime - ru0.ru_stime
+    other_cpu = None
+    if busy0 is not None and busy1 is not None:
+        other_cpu = max(0.0, (busy1 - busy0) - cpu_user - cpu_sys)
     text = proc.stdout + "\n" + proc.stderr
     log = _read_text(out_dir / "taylor_green.log")
     both = text + "\n" + log
@@ -204,6 +241,11 @@ def run_pysph(
         "cmd": cmd,
         "returncode": proc.returncode,
         "wall_s": wall,
+        "cpu_user_s": cpu_user,
+        "cpu_sys_s": cpu_sys,
+        "other_cpu_s": other_cpu,
+        "load_before": load_before,
+        "load_after": _loadavg(),
         "setup_s": grab(_RE_SETUP),
         "run_s": grab(_RE_RUN),
         "compiled": bool(_RE_COMPILING.search(both)),

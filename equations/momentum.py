@@ -2,20 +2,44 @@
 from sphgen.equation import Equation
 
 
+class AveragePressure(Equation):
+    """p_avg,a = sum_b p_b / N_a, the local mean pressure (Basa, Quinlan & Lastiwka 2009)."""
+
+    def initialize(self, d_idx, d_pavg, d_nnbr):
+        d_pavg[d_idx] = 0.0
+        d_nnbr[d_idx] = 0.0
+
+    def loop(self, d_idx, d_pavg, d_nnbr, s_idx, s_p):
+        d_pavg[d_idx] += s_p[s_idx]
+        d_nnbr[d_idx] += 1.0
+
+    def post_loop(self, d_idx, d_pavg, d_nnbr):
+        if d_nnbr[d_idx] > 0.0:
+            d_pavg[d_idx] /= d_nnbr[d_idx]
+
+
 class PressureGradient(Equation):
     """du_a/dt = -sum_b m_b (p_a/rho_a^2 + p_b/rho_b^2) grad W_ab (seed 002 eq. 27, first term).
 
-    Initialises the acceleration, so it comes first among the momentum equations.
+    With ``bql`` the pair's mean local pressure (p_avg,a + p_avg,b)/2 is subtracted
+    from p_a and p_b (after Basa, Quinlan & Lastiwka 2009; symmetric in a and b so
+    linear momentum is conserved exactly), which removes the tensile instability of
+    negative absolute pressures.  Initialises the acceleration, so it comes first.
     """
+
+    switches = ("bql",)
 
     def initialize(self, d_idx, d_au, d_av, d_aw):
         d_au[d_idx] = 0.0
         d_av[d_idx] = 0.0
         d_aw[d_idx] = 0.0
 
-    def loop(self, d_idx, d_au, d_av, d_aw, d_p, d_rho, s_idx, s_m, s_p, s_rho, DWIJ):
-        pa = d_p[d_idx] / (d_rho[d_idx] * d_rho[d_idx])
-        pb = s_p[s_idx] / (s_rho[s_idx] * s_rho[s_idx])
+    def loop(self, d_idx, d_au, d_av, d_aw, d_p, d_pavg, d_rho, s_idx, s_m, s_p, s_pavg, s_rho, DWIJ):
+        pref = 0.0
+        if self.bql:
+            pref = 0.5 * (d_pavg[d_idx] + s_pavg[s_idx])
+        pa = (d_p[d_idx] - pref) / (d_rho[d_idx] * d_rho[d_idx])
+        pb = (s_p[s_idx] - pref) / (s_rho[s_idx] * s_rho[s_idx])
         f = -s_m[s_idx] * (pa + pb)
         d_au[d_idx] += f * DWIJ[0]
         d_av[d_idx] += f * DWIJ[1]

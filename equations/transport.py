@@ -43,3 +43,23 @@ class TransportStress(Equation):
         d_au[d_idx] += mb * (d_u[d_idx] * dda + s_u[s_idx] * ddb)
         d_av[d_idx] += mb * (d_v[d_idx] * dda + s_v[s_idx] * ddb)
         d_aw[d_idx] += mb * (d_w[d_idx] * dda + s_w[s_idx] * ddb)
+
+
+class BackgroundPressureAcceleration(Equation):
+    """(du/dt)_c = -p_b sum_b m_b (1/rho_a^2 + 1/rho_b^2) grad W_ab: the TVF homogenisation
+    of seed 002 eq. 20 in the symmetric form of Adami et al. 2013 (eq. 13)."""
+
+    positive = ("pb",)
+
+    def initialize(self, d_idx, d_auhat, d_avhat, d_awhat):
+        d_auhat[d_idx] = 0.0
+        d_avhat[d_idx] = 0.0
+        d_awhat[d_idx] = 0.0
+
+    def loop(self, d_idx, d_auhat, d_avhat, d_awhat, d_rho, s_idx, s_m, s_rho, DWIJ):
+        ra = 1.0 / d_rho[d_idx]
+        rb = 1.0 / s_rho[s_idx]
+        f = -self.pb * s_m[s_idx] * (ra * ra + rb * rb)
+        d_auhat[d_idx] += f * DWIJ[0]
+        d_avhat[d_idx] += f * DWIJ[1]
+        d_awhat[d_idx] += f * DWIJ[2]

@@ -11,6 +11,20 @@ from .translate import TranslationError, specialise
 POSITION = ("x", "y", "z")
 
 
+def folded_switches(obj):
+    """Switches folded into the code: ints/bools always, floats only when zero.
+
+    A non-zero float switch stays a run-time parameter, so a sweep over it (e.g. the
+    viscosity of a Reynolds-number study) shares one compiled module.
+    """
+    out = {}
+    for k in getattr(obj, "switches", ()):
+        v = getattr(obj, k)
+        if isinstance(v, (bool, int)) or v == 0:
+            out[k] = v
+    return out
+
+
 class SceneError(ValueError):
     """A scene is inconsistent: missing property, bad array name, race, ..."""
 
@@ -173,7 +187,7 @@ class Plan:
     def _specialise(self, dead):
         for ep in self.eqplans:
             ep.kept, ep.reason, ep.methods = True, "", {}
-            consts = {k: getattr(ep.eq, k) for k in ep.eq.switches}
+            consts = folded_switches(ep.eq)
             for m in ep.eq.methods():
                 try:
                     sp = specialise(ep.eq, m, consts, ep.prefix, dim=self.dim, dead=dead.get(id(ep.eq), ()))
@@ -195,7 +209,7 @@ class Plan:
                     ep.reason = f"switched off ({sw})" if sw else "has no work"
         for st in self.steppers:
             st.stages = {}
-            consts = {k: getattr(st.stepper, k) for k in getattr(st.stepper, "switches", ())}
+            consts = folded_switches(st.stepper)
             for m in st.stepper.stage_methods():
                 sp = specialise(st.stepper, m, consts, st.prefix, dim=self.dim)
                 if not sp.empty:

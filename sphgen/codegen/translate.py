@@ -167,6 +167,32 @@ class _DeadStores(ast.NodeTransformer):
         return node if node.body else None
 
 
+def _remove_dead_locals(fdef):
+    """Drop assignments to local names that nothing reads (after folding), repeatedly."""
+    while True:
+        loads = {n.id for n in ast.walk(fdef) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
+        dead = []
+        for node in ast.walk(fdef):
+            for field in ("body", "orelse"):
+                body = getattr(node, field, None)
+                if not isinstance(body, list):
+                    continue
+                for st in body:
+                    if isinstance(st, ast.Assign) and all(isinstance(t, ast.Name) and t.id not in loads
+                                                          for t in st.targets) and \
+                            not (isinstance(st.value, ast.Call) and getattr(st.value.func, "id", "") == "declare"):
+                        dead.append((body, st))
+        if not dead:
+            return
+        for body, st in dead:
+            body.remove(st)
+        for node in ast.walk(fdef):
+            for field in ("body", "orelse"):
+                body = getattr(node, field, None)
+                if isinstance(body, list) and field == "body" and not body and node is not fdef:
+                    body.append(ast.Pass())
+
+
 def _names(tree):
     return {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)}
 
@@ -255,6 +281,7 @@ def specialise(owner, method, constants, prefix, keep_defaults=False, dim=3, dea
         fdef = sp.visit(fdef)
     if not fdef.body:
         fdef.body = [ast.Pass()]
+    _remove_dead_locals(fdef)
     _declare_loop_counters(fdef)
     used = _names(ast.Module(body=fdef.body, type_ignores=[]))
     keep = [a for a in fdef.args.args if a.arg in used]

@@ -108,10 +108,15 @@ class NeighbourSearch:
     radius_scale : the kernel support factor k: neighbours have
         ``|r_ij| < k * max(h_i, h_j)``.
     domain : a :class:`Domain` (periodic axes), or None (open in every axis).
-    sort : if True, spatially sort the arrays once at construction (``sort()``).
+    sort : if True, spatially sort the arrays once at construction (:meth:`sort`
+        permutes them in place).
 
-    The lists are built at construction; call :meth:`update` whenever positions or
-    ``h`` changed (the lists use the cells built by the last update).
+    The cells are built at construction and by :meth:`update`, which takes a copy of
+    the positions and ``h``: the lists describe the particles as they were at the
+    last update, so call it whenever positions or ``h`` changed.
+
+    Attributes: ``n_updates``, ``grid`` (the cell grid), ``cell_size`` and
+    ``n_cells`` (per axis), ``arrays``, ``dim``, ``radius_scale``, ``domain``.
     """
 
     def __init__(self, arrays, dim, radius_scale, domain=None, sort=True):
@@ -171,9 +176,8 @@ class NeighbourSearch:
                        f"({', '.join(self._by_name)})")
 
     def _coords(self, pa):
-        """[x, y, z] float64 arrays of ``pa`` (axes past ``dim`` repeat ``x``, unread)."""
-        xs = [pa.get(_AXES[a]) for a in range(self.dim)]
-        return xs + [xs[0]] * (3 - self.dim)
+        """The ``dim`` coordinate arrays of ``pa``."""
+        return [pa.get(_AXES[a]) for a in range(self.dim)]
 
     # ------------------------------------------------------------ building
     def update(self):
@@ -222,7 +226,8 @@ class NeighbourSearch:
         self._bins = {}
         self._sizes = {}
         for pa in self.arrays:
-            self._bins[pa.name] = bin_particles(self.grid, self._coords(pa), pa.get("h"))
+            self._bins[pa.name] = bin_particles(self.grid, self._coords(pa), pa.get("h"),
+                                                 self.radius_scale)
             self._sizes[pa.name] = pa.n
         self._cache = {}
 
@@ -274,7 +279,8 @@ class NeighbourSearch:
         the indices j of ``src`` (ascending) with ``|r_ij| < k*max(h_i, h_j)``.
 
         ``dest`` and ``src`` are array names or the arrays.  Computed on first use
-        after an update and cached: do not modify the returned arrays."""
+        after an update (positions and h as they were at that update) and cached
+        until the next one: do not modify the returned arrays."""
         d, s = self._array(dest), self._array(src)
         key = (d.name, s.name)
         lists = self._cache.get(key)
@@ -283,9 +289,7 @@ class NeighbourSearch:
                 if pa.n != self._sizes[pa.name]:
                     raise RuntimeError(f"array '{pa.name}' has {pa.n} particles but had "
                                        f"{self._sizes[pa.name]} at the last update(): call update()")
-            cell_start, cell_index = self._bins[s.name]
-            lists = build_csr(self.grid, self._coords(d), d.get("h"), self._coords(s),
-                              s.get("h"), cell_start, cell_index, self.radius_scale)
+            lists = build_csr(self.grid, self._bins[d.name], self._bins[s.name])
             self._cache[key] = lists
         return lists
 
@@ -317,8 +321,7 @@ class NeighbourSearch:
         Morton order) with ``pa.permute(perm)``, remap the frozen reference lists
         and rebuild.  Returns ``{name: perm}`` with ``new[k] = old[perm[k]]``."""
         self._build()
-        perms = {}
-        inverse = {}
+        perms, inverse = {}, {}
         for pa in self.arrays:
             perm = self._bins[pa.name][1].copy()
             inv = np.empty_like(perm)
@@ -326,6 +329,11 @@ class NeighbourSearch:
             pa.permute(perm)
             perms[pa.name], inverse[pa.name] = perm, inv
         for (d, s), (offsets, nbrs) in list(self._frozen.items()):
+            n_d, n_s = perms[d].size, perms[s].size
+            if offsets.size != n_d + 1 or (nbrs.size and int(nbrs.max()) >= n_s):
+                raise ValueError(f"the reference list frozen for dest '{d}', src '{s}' does "
+                                 f"not fit arrays of {n_d} and {n_s} particles (did the "
+                                 "particle count change since freeze()?)")
             self._frozen[(d, s)] = remap_csr(offsets, nbrs, perms[d], inverse[s])
         self._build()
         return perms

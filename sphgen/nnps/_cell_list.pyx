@@ -9,8 +9,8 @@ the per-particle work:
   first non-finite value of an array;
 * ``bin_particles``: put every particle in a cell and counting-sort the particles by
   cell.  A bin is ``cell_start`` (CSR over cells), ``cell_index`` (particle indices
-  in cell order) and ``pts``, a copy of ``(x, y, z, h)`` in cell order (unused axes
-  zero) so that the distance loops read contiguous memory;
+  in cell order) and ``pts``, records ``(x, y, z, (k h)**2)`` in cell order (unused
+  axes zero) so that the distance loops read contiguous memory;
 * ``build_csr``: for every destination particle ``i``, the source particles ``j``
   with ``|r_ij| < k * max(h_i, h_j)`` as int32 CSR lists.  Three steps:
 
@@ -41,6 +41,10 @@ import numpy as np
 
 # ---------------------------------------------------------------------- structs
 
+# cells are skipped only if farther than the cut-off by this factor (rounding safety)
+cdef double _REACH_MARGIN = 1.000002
+
+
 ctypedef struct Grid:
     int dim              # number of coordinates that count
     double lo[3]         # lower corner of cell (0, 0, 0)
@@ -58,8 +62,16 @@ ctypedef struct Grid:
 ctypedef struct Bins:
     const int* start     # cell_start, ncells + 1 entries
     const int* index     # particle index at each cell-order position
-    const double* pts    # (x, y, z, h) at each cell-order position
+    const double* pts    # (x, y, z, (k h)**2) at each cell-order position
     Py_ssize_t n
+
+
+ctypedef struct Stencil:
+    int nc               # number of neighbour cells
+    int cells[27]        # their ranks, ascending
+    double shift[27][3]  # image shift added to x_i - x_j for each cell
+    int side[27][3]      # 0: cell below on that axis, 2: above, 1: same/unprunable
+    double corner[3]     # lower corner of the centre cell
 
 
 ctypedef struct Row:
@@ -122,6 +134,14 @@ cdef Bins _bins(int[::1] cell_start, int[::1] cell_index, double[:, ::1] pts) ex
     return b
 
 
+cdef const double* _coord_ptr(double[::1] v, Py_ssize_t n) except? NULL:
+    """Pointer to the data of a coordinate array of ``n`` values (NULL if empty);
+    the caller keeps the array alive."""
+    if v.shape[0] != n:
+        raise ValueError(f"a coordinate array has {v.shape[0]} values, h has {n}")
+    return &v[0] if n > 0 else NULL
+
+
 cdef inline int* _iptr(int[::1] v) noexcept:
     """Pointer to the first element, NULL for an empty view."""
     return &v[0] if v.shape[0] > 0 else NULL
@@ -133,12 +153,12 @@ cdef inline int _cell_coord(const Grid* g, int a, double x) noexcept nogil:
     cdef double t
     if a >= g.dim:
         return 0
-    t = floor((x - g.lo[a]) / g.cs[a])
+    t = (x - g.lo[a]) / g.cs[a]
     if not (t >= 0.0):          # also catches NaN
         return 0
     if t >= g.n[a] - 1:
         return g.n[a] - 1
-    return <int>t
+    return <int>t               # truncation is floor for t >= 0
 
 
 cdef inline double _min_image(const Grid* g, int a, double d) noexcept nogil:
@@ -150,20 +170,23 @@ cdef inline double _min_image(const Grid* g, int a, double d) noexcept nogil:
     return d
 
 
-cdef int _axis_candidates(const Grid* g, int a, int c, int* out,
-                          double* shift) noexcept nogil:
+cdef int _axis_candidates(const Grid* g, int a, int c, int* out, double* shift,
+                          int* side) noexcept nogil:
     """Distinct cell coordinates along axis ``a`` that may hold neighbours of cell
-    ``c``, with the image shift to add to ``x_i - x_j`` for each; returns the count."""
+    ``c``; for each, the image shift to add to ``x_i - x_j`` and the side (0 below,
+    1 same or not prunable, 2 above).  Returns the count."""
     cdef int m = 0, k, q
     cdef double s
     if a >= g.dim:
         out[0] = 0
         shift[0] = 0.0
+        side[0] = 1
         return 1
     if g.all_cells[a]:          # pair-by-pair minimum image instead of a shift
         for k in range(g.n[a]):
             out[k] = k
             shift[k] = 0.0
+            side[k] = 1
         return g.n[a]
     for k in range(-1, 2):
         q = c + k
@@ -180,47 +203,59 @@ cdef int _axis_candidates(const Grid* g, int a, int c, int* out,
             s = -g.length[a]    # ... at x + L
         out[m] = q
         shift[m] = s
+        side[m] = k + 1
         m += 1
     return m
 
 
-cdef int _neighbour_cells(const Grid* g, int rank, int* cells,
-                          double* shifts) noexcept nogil:
-    """Ranks of the (at most 27, distinct) cells around the cell of rank ``rank``,
-    ascending, and their image shifts (``shifts[3*m + a]``); returns their number."""
+cdef void _swap_cells(Stencil* st, int p, int q) noexcept nogil:
+    cdef int a, ti
+    cdef double td
+    ti = st.cells[p]
+    st.cells[p] = st.cells[q]
+    st.cells[q] = ti
+    for a in range(3):
+        td = st.shift[p][a]
+        st.shift[p][a] = st.shift[q][a]
+        st.shift[q][a] = td
+        ti = st.side[p][a]
+        st.side[p][a] = st.side[q][a]
+        st.side[q][a] = ti
+
+
+cdef void _stencil(const Grid* g, int rank, Stencil* st) noexcept nogil:
+    """The (at most 27, distinct) cells around the cell of rank ``rank``, sorted by
+    rank, with their image shifts and sides; and the cell's lower corner."""
     cdef int cand[3][3]
     cdef double sh[3][3]
+    cdef int sd[3][3]
     cdef int m[3]
     cdef int c[3]
-    cdef int a, p, q, r, u, nc = 0, lin = g.unrank[rank]
-    cdef double s0, s1, s2
+    cdef int a, p, q, r, lin = g.unrank[rank]
     c[0] = lin % g.n[0]
     c[1] = (lin // g.n[0]) % g.n[1]
     c[2] = lin // (g.n[0] * g.n[1])
     for a in range(3):
-        m[a] = _axis_candidates(g, a, c[a], cand[a], sh[a])
+        m[a] = _axis_candidates(g, a, c[a], cand[a], sh[a], sd[a])
+        st.corner[a] = g.lo[a] + c[a] * g.cs[a]
+    st.nc = 0
     for r in range(m[2]):
         for q in range(m[1]):
             for p in range(m[0]):
-                cells[nc] = g.rank[cand[0][p] + g.n[0] * (cand[1][q] + g.n[1] * cand[2][r])]
-                shifts[3 * nc] = sh[0][p]
-                shifts[3 * nc + 1] = sh[1][q]
-                shifts[3 * nc + 2] = sh[2][r]
-                nc += 1
-    # insertion sort by rank, carrying the shifts along
-    for p in range(1, nc):
-        u = cells[p]
-        s0, s1, s2 = shifts[3 * p], shifts[3 * p + 1], shifts[3 * p + 2]
-        q = p - 1
-        while q >= 0 and cells[q] > u:
-            cells[q + 1] = cells[q]
-            shifts[3 * q + 3] = shifts[3 * q]
-            shifts[3 * q + 4] = shifts[3 * q + 1]
-            shifts[3 * q + 5] = shifts[3 * q + 2]
+                st.cells[st.nc] = g.rank[cand[0][p] + g.n[0] * (cand[1][q] + g.n[1] * cand[2][r])]
+                st.shift[st.nc][0] = sh[0][p]
+                st.shift[st.nc][1] = sh[1][q]
+                st.shift[st.nc][2] = sh[2][r]
+                st.side[st.nc][0] = sd[0][p]
+                st.side[st.nc][1] = sd[1][q]
+                st.side[st.nc][2] = sd[2][r]
+                st.nc += 1
+    for p in range(1, st.nc):       # insertion sort by rank (<= 27 cells)
+        q = p
+        while q > 0 and st.cells[q - 1] > st.cells[q]:
+            _swap_cells(st, q - 1, q)
             q -= 1
-        cells[q + 1] = u
-        shifts[3 * q + 3], shifts[3 * q + 4], shifts[3 * q + 5] = s0, s1, s2
-    return nc
+
 
 # ----------------------------------------------------------------- row sorting
 
@@ -279,50 +314,62 @@ cdef void _sort_row(int* v, Py_ssize_t n) noexcept nogil:
 
 # ------------------------------------------------------------ scanning cells
 
-cdef Py_ssize_t _scan_cell(const double* xi, double k, const Bins* s, int cell,
+cdef Py_ssize_t _scan_cell(int dim, const double* xi, const Bins* s, int cell,
                            const double* shift, int* out) noexcept nogil:
-    """Append to ``out`` the sources of ``cell`` within reach of ``xi`` = (x, y, z, h),
-    the cell seen through the image ``shift``; returns how many.  Branch-free: ``out``
-    must have room for every particle of the cell."""
+    """Append to ``out`` the sources of ``cell`` within reach of ``xi`` (a ``pts``
+    record), the cell seen through the image ``shift``; returns how many.
+
+    A pair is in reach if ``r2 < max(reach2_i, reach2_j)``, which is exactly
+    ``r2 < (k max(h_i, h_j))**2``.  Branch-free: ``out`` must have room for every
+    particle of the cell."""
     cdef Py_ssize_t p, cnt = 0
     cdef const double* q
-    cdef double dx, dy, dz, hj, rc, r2
-    cdef double x0 = xi[0] + shift[0], y0 = xi[1] + shift[1], z0 = xi[2] + shift[2]
-    cdef double hi = xi[3]
-    for p in range(s.start[cell], s.start[cell + 1]):
-        q = s.pts + 4 * p
-        dx = (xi[0] - q[0]) + shift[0]
-        dy = (xi[1] - q[1]) + shift[1]
-        dz = (xi[2] - q[2]) + shift[2]
-        hj = q[3]
-        rc = k * (hi if hi > hj else hj)
-        r2 = dx * dx + dy * dy + dz * dz
-        out[cnt] = s.index[p]
-        cnt += r2 < rc * rc
+    cdef double dx, dy, dz, r2, rc2
+    cdef double x0 = xi[0], y0 = xi[1], z0 = xi[2], ri2 = xi[3]
+    cdef double sx = shift[0], sy = shift[1], sz = shift[2]
+    if dim == 3:
+        for p in range(s.start[cell], s.start[cell + 1]):
+            q = s.pts + 4 * p
+            dx = (x0 - q[0]) + sx
+            dy = (y0 - q[1]) + sy
+            dz = (z0 - q[2]) + sz
+            rc2 = ri2 if ri2 > q[3] else q[3]
+            r2 = dx * dx + dy * dy + dz * dz
+            out[cnt] = s.index[p]
+            cnt += r2 < rc2
+    else:                       # 1D and 2D: y is 0 in 1D
+        for p in range(s.start[cell], s.start[cell + 1]):
+            q = s.pts + 4 * p
+            dx = (x0 - q[0]) + sx
+            dy = (y0 - q[1]) + sy
+            rc2 = ri2 if ri2 > q[3] else q[3]
+            r2 = dx * dx + dy * dy
+            out[cnt] = s.index[p]
+            cnt += r2 < rc2
     return cnt
 
 
-cdef Py_ssize_t _scan_cell_pair_image(const Grid* g, const double* xi, double k,
-                                      const Bins* s, int cell, const double* shift,
+cdef Py_ssize_t _scan_cell_pair_image(const Grid* g, const double* xi, const Bins* s,
+                                      int cell, const double* shift,
                                       int* out) noexcept nogil:
     """``_scan_cell`` for grids with a periodic axis of < 3 cells: the minimum image
     is taken pair by pair on those axes."""
     cdef Py_ssize_t p, cnt = 0
     cdef const double* q
     cdef double d[3]
-    cdef double hj, rc, r2, hi = xi[3]
+    cdef double r2, rc2
     cdef int a
     for p in range(s.start[cell], s.start[cell + 1]):
         q = s.pts + 4 * p
-        for a in range(3):
+        r2 = 0.0
+        for a in range(g.dim):
             d[a] = (xi[a] - q[a]) + shift[a]
             if g.all_cells[a]:
                 d[a] = _min_image(g, a, d[a])
-        hj = q[3]
-        rc = k * (hi if hi > hj else hj)
-        r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+            r2 = r2 + d[a] * d[a]
+        rc2 = xi[3] if xi[3] > q[3] else q[3]
         out[cnt] = s.index[p]
-        cnt += r2 < rc * rc
+        cnt += r2 < rc2
     return cnt
 
 
@@ -343,34 +390,62 @@ cdef int _reserve(Row* buf, Py_ssize_t extra) noexcept nogil:
     return 0
 
 
-cdef int _block_rows(const Grid* g, const Bins* d, const Bins* s, double k,
-                     int cell_lo, int cell_hi, int* counts, Row* buf) noexcept nogil:
+cdef inline bint _out_of_reach(const Stencil* st, int c, const double* xi,
+                               const double* cs, double reach2) noexcept nogil:
+    """True if every point of neighbour cell ``c`` is at least ``sqrt(reach2)`` from
+    ``xi`` (squared distance from the point to the cell box, per axis the gap to the
+    face of the centre cell on that side)."""
+    cdef double gap, d2 = 0.0
+    cdef int a
+    for a in range(3):
+        if st.side[c][a] == 0:
+            gap = xi[a] - st.corner[a]
+        elif st.side[c][a] == 2:
+            gap = st.corner[a] + cs[a] - xi[a]
+        else:
+            continue
+        if gap > 0.0:
+            d2 += gap * gap
+    return d2 >= reach2
+
+
+cdef int _block_rows(const Grid* g, const Bins* d, const Bins* s, double reach2_s,
+                     bint src_in_cell_order, int cell_lo, int cell_hi, int* counts,
+                     Row* buf) noexcept nogil:
     """Count pass of one block of destination cells ``[cell_lo, cell_hi)``: the rows
     of its particles (in cell order) go to ``buf``, their lengths to ``counts``.
-    Returns 0, or -1 if out of memory."""
-    cdef int cells[27]
-    cdef double shifts[81]
-    cdef int nc, c, r, i
+    ``reach2_s`` is the largest source ``(k h)**2``; if ``src_in_cell_order`` the
+    rows come out ascending (cells are visited by rank).  Returns 0, or -1 if out
+    of memory."""
+    cdef Stencil st
+    cdef int c, r, i
     cdef Py_ssize_t p, upper, cnt
+    cdef const double* xi
+    cdef double reach2
+    cdef int* out
     for r in range(cell_lo, cell_hi):
         if d.start[r] == d.start[r + 1]:
             continue
-        nc = _neighbour_cells(g, r, cells, shifts)
+        _stencil(g, r, &st)
         upper = 0
-        for c in range(nc):
-            upper += s.start[cells[c] + 1] - s.start[cells[c]]
+        for c in range(st.nc):
+            upper += s.start[st.cells[c] + 1] - s.start[st.cells[c]]
         for p in range(d.start[r], d.start[r + 1]):
             if _reserve(buf, upper) != 0:
                 return -1
+            xi = d.pts + 4 * p
+            reach2 = (xi[3] if xi[3] > reach2_s else reach2_s) * _REACH_MARGIN
+            out = buf.data + buf.used
             cnt = 0
-            for c in range(nc):
+            for c in range(st.nc):
+                if _out_of_reach(&st, c, xi, g.cs, reach2):
+                    continue
                 if g.any_all_cells:
-                    cnt += _scan_cell_pair_image(g, d.pts + 4 * p, k, s, cells[c],
-                                                 shifts + 3 * c, buf.data + buf.used + cnt)
+                    cnt += _scan_cell_pair_image(g, xi, s, st.cells[c], st.shift[c], out + cnt)
                 else:
-                    cnt += _scan_cell(d.pts + 4 * p, k, s, cells[c], shifts + 3 * c,
-                                      buf.data + buf.used + cnt)
-            _sort_row(buf.data + buf.used, cnt)
+                    cnt += _scan_cell(g.dim, xi, s, st.cells[c], st.shift[c], out + cnt)
+            if not src_in_cell_order:
+                _sort_row(out, cnt)
             i = d.index[p]
             counts[i] = <int>cnt
             buf.used += cnt
@@ -458,28 +533,28 @@ def scan(double[::1] x):
     return lo, hi, -1
 
 
-def bin_particles(GridSpec grid, list coords, double[::1] h):
+def bin_particles(GridSpec grid, list coords, double[::1] h, double radius_scale):
     """Bin particles into the grid's cells (stable counting sort).
 
     ``coords`` holds the x, y, z arrays (entries past ``dim`` are not read).
     Returns ``(cell_start, cell_index, pts)``: the particles of the cell of rank ``r``
     are ``cell_index[cell_start[r]:cell_start[r+1]]`` (ascending) and ``pts[p]`` is
-    ``(x, y, z, h)`` of particle ``cell_index[p]`` (unused axes 0)."""
+    ``(x, y, z, (k h)**2)`` of particle ``cell_index[p]`` (unused axes 0), with ``k``
+    the radius scale."""
     cdef const Grid* g = &grid.c
     cdef Py_ssize_t n = h.shape[0], ncells = grid.ncells, i, p
     cdef int a, c, lin
     cdef const double* x[3]
-    cdef double[::1] xa
+    start_arr = np.zeros(ncells + 1, dtype=np.int32)
+    index_arr = np.empty(n, dtype=np.int32)
+    pts_arr = np.zeros((n, 4), dtype=np.float64)
     cdef int[::1] cell_of = np.empty(n, dtype=np.int32)
-    cdef int[::1] cell_start = np.zeros(ncells + 1, dtype=np.int32)
-    cdef int[::1] cell_index = np.empty(n, dtype=np.int32)
+    cdef int[::1] cell_start = start_arr
+    cdef int[::1] cell_index = index_arr
     cdef int[::1] fill
-    cdef double[:, ::1] pts = np.zeros((n, 4), dtype=np.float64)
+    cdef double[:, ::1] pts = pts_arr
     for a in range(g.dim):
-        xa = coords[a]
-        if xa.shape[0] != n:
-            raise ValueError(f"coordinate {a} has {xa.shape[0]} values, h has {n}")
-        x[a] = &xa[0] if n > 0 else NULL
+        x[a] = _coord_ptr(coords[a], n)
     for i in prange(n, nogil=True, schedule="static"):
         lin = 0
         for a in range(g.dim - 1, -1, -1):
@@ -489,7 +564,9 @@ def bin_particles(GridSpec grid, list coords, double[::1] h):
         cell_start[cell_of[i] + 1] += 1
     for i in range(ncells):
         cell_start[i + 1] += cell_start[i]
-    fill = np.array(cell_start[:ncells], dtype=np.int32)
+    fill = np.empty(ncells, dtype=np.int32)
+    for i in range(ncells):
+        fill[i] = cell_start[i]
     for i in range(n):
         c = cell_of[i]
         cell_index[fill[c]] = <int>i
@@ -498,30 +575,39 @@ def bin_particles(GridSpec grid, list coords, double[::1] h):
         i = cell_index[p]
         for a in range(g.dim):
             pts[p, a] = x[a][i]
-        pts[p, 3] = h[i]
-    return np.asarray(cell_start), np.asarray(cell_index), np.asarray(pts)
+        pts[p, 3] = (radius_scale * h[i]) * (radius_scale * h[i])
+    return start_arr, index_arr, pts_arr
 
 
-def build_csr(GridSpec grid, dest_bins, src_bins, double radius_scale,
-              Py_ssize_t block_size=128):
+def build_csr(GridSpec grid, dest_bins, src_bins, Py_ssize_t block_size=128):
     """CSR neighbour lists of every destination particle among the source particles.
 
     ``dest_bins``/``src_bins`` are ``bin_particles`` results on the same grid.
     Returns ``(offsets, nbrs)``, int32, each row ascending."""
-    cdef Bins d = _bins(*dest_bins)
-    cdef Bins s = _bins(*src_bins)
+    cdef int[::1] d_start, d_index, s_start, s_index
+    cdef double[:, ::1] d_pts, s_pts
+    d_start, d_index, d_pts = dest_bins
+    s_start, s_index, s_pts = src_bins
+    cdef Bins d = _bins(d_start, d_index, d_pts)
+    cdef Bins s = _bins(s_start, s_index, s_pts)
     cdef const Grid* g = &grid.c
     cdef Py_ssize_t nd = d.n, ncells = grid.ncells, nb, b
     cdef int[::1] counts = np.zeros(nd, dtype=np.int32)
-    cdef int[::1] offsets = np.empty(nd + 1, dtype=np.int32)
+    offsets_arr = np.empty(nd + 1, dtype=np.int32)
+    cdef int[::1] offsets = offsets_arr
     cdef int[::1] bounds = np.empty(ncells + 1, dtype=np.int32)
     cdef int[::1] nbrs
     cdef int* pn
+    cdef int* pc = _iptr(counts)
     cdef Row* bufs
     cdef int failed = 0
-    cdef double k = radius_scale
-    if d.start == NULL or s.start == NULL:
-        raise ValueError("empty bins")
+    cdef double reach2_s = 0.0
+    cdef bint in_order = True
+    for b in range(s.n):
+        if s.pts[4 * b + 3] > reach2_s:
+            reach2_s = s.pts[4 * b + 3]
+        if s.index[b] != b:
+            in_order = False
     nb = _make_blocks(&d, ncells, block_size, bounds)
     bufs = <Row*>malloc(nb * sizeof(Row))
     if bufs == NULL:
@@ -532,12 +618,12 @@ def build_csr(GridSpec grid, dest_bins, src_bins, double radius_scale,
         bufs[b].cap = 0
     try:
         for b in prange(nb, nogil=True, schedule="dynamic"):
-            if _block_rows(g, &d, &s, k, bounds[b], bounds[b + 1], _iptr(counts), &bufs[b]) != 0:
-                failed = 1
+            failed += _block_rows(g, &d, &s, reach2_s, in_order, bounds[b], bounds[b + 1], pc, &bufs[b]) != 0
         if failed:
             raise MemoryError("out of memory while building neighbour lists")
-        _prefix_sum(_iptr(counts), nd, offsets)
-        nbrs = np.empty(offsets[nd], dtype=np.int32)
+        _prefix_sum(pc, nd, offsets)
+        nbrs_arr = np.empty(offsets[nd], dtype=np.int32)
+        nbrs = nbrs_arr
         pn = _iptr(nbrs)
         for b in prange(nb, nogil=True, schedule="static"):
             _block_fill(&d, bounds[b], bounds[b + 1], &offsets[0], &bufs[b], pn)
@@ -545,7 +631,7 @@ def build_csr(GridSpec grid, dest_bins, src_bins, double radius_scale,
         for b in range(nb):
             free(bufs[b].data)
         free(bufs)
-    return np.asarray(offsets), np.asarray(nbrs)
+    return offsets_arr, nbrs_arr
 
 
 def remap_csr(int[::1] offsets, int[::1] nbrs, int[::1] perm_dest, int[::1] inv_src):
@@ -555,7 +641,8 @@ def remap_csr(int[::1] offsets, int[::1] nbrs, int[::1] perm_dest, int[::1] inv_
     source indices.  Returns the new ``(offsets, nbrs)``, rows ascending."""
     cdef Py_ssize_t nd = perm_dest.shape[0], i, p, o, start, cnt
     cdef int[::1] counts = np.empty(nd, dtype=np.int32)
-    cdef int[::1] new_off = np.empty(nd + 1, dtype=np.int32)
+    new_off_arr = np.empty(nd + 1, dtype=np.int32)
+    cdef int[::1] new_off = new_off_arr
     cdef int[::1] new_nbrs
     cdef int* pn
     if offsets.shape[0] != nd + 1:
@@ -563,7 +650,8 @@ def remap_csr(int[::1] offsets, int[::1] nbrs, int[::1] perm_dest, int[::1] inv_
     for i in prange(nd, nogil=True, schedule="static"):
         counts[i] = offsets[perm_dest[i] + 1] - offsets[perm_dest[i]]
     _prefix_sum(_iptr(counts), nd, new_off)
-    new_nbrs = np.empty(new_off[nd], dtype=np.int32)
+    new_nbrs_arr = np.empty(new_off[nd], dtype=np.int32)
+    new_nbrs = new_nbrs_arr
     pn = _iptr(new_nbrs)
     for i in prange(nd, nogil=True, schedule="static"):
         start = offsets[perm_dest[i]]
@@ -572,4 +660,4 @@ def remap_csr(int[::1] offsets, int[::1] nbrs, int[::1] perm_dest, int[::1] inv_
         for p in range(cnt):
             pn[o + p] = inv_src[nbrs[start + p]]
         _sort_row(pn + o, cnt)
-    return np.asarray(new_off), np.asarray(new_nbrs)
+    return new_off_arr, new_nbrs_arr

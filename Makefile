@@ -1,0 +1,32 @@
+# The two README commands: `make run` and `make test`. Both create .venv on first use.
+PYTHON ?= python3
+VENV   := .venv
+PY     := $(VENV)/bin/python
+STAMP  := $(VENV)/.installed
+
+.PHONY: run test test-slow bench docs clean
+
+$(STAMP): setup.py pyproject.toml $(wildcard sphgen/nnps/*.pyx)
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e .
+	touch $(STAMP)
+
+run: $(STAMP)
+	$(VENV)/bin/sphgen run taylor_green --nx 50 --re 100 --tf 0.5 -d outputs/taylor_green
+
+test: $(STAMP)
+	$(PY) -m pytest -q
+
+test-slow: $(STAMP)
+	$(PY) -m pytest -q -m slow
+
+bench: $(STAMP)
+	$(PY) benchmarks/bench_taylor_green.py
+
+docs: $(STAMP)
+	$(PY) -m pip install --quiet sphinx
+	$(VENV)/bin/sphinx-build -q -b html docs docs/_build/html
+
+clean:
+	rm -rf $(VENV) build *.egg-info outputs

@@ -1,0 +1,141 @@
+"""Taylor-Green vortex in a periodic unit box (seed 002 section 3.1).
+
+u = -U e^{bt} cos(2 pi x) sin(2 pi y), v = U e^{bt} sin(2 pi x) cos(2 pi y),
+p = -U^2 e^{2bt} (cos(4 pi x) + cos(4 pi y)) / 4, b = -8 pi^2 / Re.
+``post_process`` writes results.json (L1 error of |u|, seed 002 eq. 66; max |u| and
+its exact decay) and a plot of both over time.
+"""
+import json
+import os
+from math import pi
+
+import numpy as np
+
+from sphgen import io
+from sphgen.app import Application
+from sphgen.nnps import Domain
+from sphgen.particles import ParticleArray
+
+from ..schemes.edac import PSTS, EDACScheme
+
+
+def exact_velocity(x, y, t, re, U=1.0):
+    """(u, v) of the Taylor-Green vortex at time t."""
+    decay = U * np.exp(-8.0 * pi * pi * t / re)
+    return (-decay * np.cos(2 * pi * x) * np.sin(2 * pi * y),
+            decay * np.sin(2 * pi * x) * np.cos(2 * pi * y))
+
+
+def l1_error(x, y, u, v, t, re):
+    """sum_i | |u_i| - |u_ex(x_i, t)| | / sum_i |u_ex(x_i, t)| (seed 002 eq. 66)."""
+    ue, ve = exact_velocity(x, y, t, re)
+    vmag, emag = np.hypot(u, v), np.hypot(ue, ve)
+    return float(np.abs(vmag - emag).sum() / emag.sum())
+
+
+class TaylorGreen(Application):
+    """Taylor-Green vortex, EDAC scheme, periodic unit box."""
+
+    tf = 0.5
+    pfreq = 200
+    dim = 2
+
+    def add_user_options(self, group):
+        group.add_argument("--nx", type=int, default=50, help="particles per side (default %(default)s)")
+        group.add_argument("--re", type=float, default=100.0, help="Reynolds number (default %(default)s)")
+        group.add_argument("--hdx", type=float, default=1.0, help="h / dx (default %(default)s)")
+        group.add_argument("--pst", choices=PSTS, default="sun2019",
+                           help="particle shifting (default %(default)s)")
+        group.add_argument("--c0", type=float, default=10.0, help="artificial sound speed (default 10 U)")
+        group.add_argument("--perturb", type=float, default=0.0,
+                           help="random lattice perturbation in units of dx (default 0)")
+        group.add_argument("--output-vorticity", action="store_true",
+                           help="also compute and write the vorticity 'omega'")
+
+    def consume_user_options(self, o):
+        if o.nx < 4:
+            raise SystemExit(f"--nx must be at least 4, got {o.nx}")
+        for name in ("re", "hdx", "c0"):
+            v = getattr(o, name)
+            if not (np.isfinite(v) and v > 0):
+                raise SystemExit(f"--{name} must be a positive finite number, got {v}")
+        if not (np.isfinite(o.perturb) and 0 <= o.perturb < 0.5):
+            raise SystemExit(f"--perturb must be in [0, 0.5), got {o.perturb}")
+        self.nx, self.re = o.nx, o.re
+        self.dx = 1.0 / o.nx
+        self.h = o.hdx * self.dx
+        self.nu = 1.0 / o.re
+        self.history = []
+
+    def create_particles(self):
+        dx = self.dx
+        x, y = np.mgrid[dx / 2:1:dx, dx / 2:1:dx]
+        x, y = x.ravel(), y.ravel()
+        if self.options.perturb > 0:
+            rng = np.random.default_rng(1)
+            x = x + self.options.perturb * dx * rng.uniform(-1, 1, x.size)
+            y = y + self.options.perturb * dx * rng.uniform(-1, 1, x.size)
+        u, v = exact_velocity(x, y, 0.0, self.re)
+        p = -0.25 * (np.cos(4 * pi * x) + np.cos(4 * pi * y))
+        fluid = ParticleArray("fluid", x=x, y=y, u=u, v=v, p=p, m=np.full(x.size, dx * dx),
+                              h=np.full(x.size, self.h), rho=np.ones(x.size))
+        return [fluid]
+
+    def create_domain(self):
+        return Domain(0.0, 1.0, 0.0, 1.0, periodic_in_x=True, periodic_in_y=True)
+
+    def create_scheme(self):
+        s = EDACScheme(["fluid"], dim=2, rho0=1.0, c0=self.options.c0, nu=self.nu, h=self.h,
+                       dx=self.dx, umax=1.0, pst=self.options.pst)
+        if self.options.output_vorticity:
+            s.output_props = s.output_props + ("omega",)
+        return s
+
+    def post_step(self, solver):
+        every = max(1, int(round(0.005 / solver.dt)))
+        if solver.step % every == 0 or solver.t >= solver.tf - 1e-12 or len(self.history) == 0:
+            self.record(solver.t)
+
+    def record(self, t):
+        f = self.scene.by_name["fluid"]
+        vmag = np.hypot(f.u, f.v)
+        self.history.append((t, float(vmag.max()), float(np.exp(-8 * pi * pi * t / self.re)),
+                             l1_error(f.x, f.y, f.u, f.v, t, self.re)))
+
+    def post_process(self, outdir):
+        hist_path = os.path.join(outdir, "history.json")
+        if getattr(self, "history", None):
+            io.write_json(hist_path, {"columns": ["t", "max_u", "max_u_exact", "l1_error"],
+                                      "rows": self.history, "re": self.re, "nx": self.nx})
+        with open(hist_path) as f:
+            hist = json.load(f)
+        rows = np.array(hist["rows"])
+        t, umax, uex, l1 = rows.T
+        results = {"t": float(t[-1]), "l1_error": float(l1[-1]), "max_u": float(umax[-1]),
+                   "max_u_exact": float(uex[-1]), "max_u_rel_error": float(umax[-1] / uex[-1] - 1.0),
+                   "l1_error_max": float(l1.max()), "nx": hist["nx"], "re": hist["re"]}
+        io.write_json(os.path.join(outdir, "results.json"), results)
+        self.plot(outdir, t, umax, uex, l1)
+        print(f"taylor_green: t={results['t']:.4g}  L1(|u|)={results['l1_error']:.4f}  "
+              f"max|u|={results['max_u']:.5f} (exact {results['max_u_exact']:.5f}, "
+              f"{100 * results['max_u_rel_error']:+.2f}%)\n"
+              f"results: {os.path.join(outdir, 'results.json')}\nfigure:  {os.path.join(outdir, 'decay.png')}")
+        return results
+
+    @staticmethod
+    def plot(outdir, t, umax, uex, l1):
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        fig, (a, b) = plt.subplots(1, 2, figsize=(10, 4))
+        a.semilogy(t, uex, "k-", label="exact $e^{-8\\pi^2 t/Re}$")
+        a.semilogy(t, umax, "r--", label="sphgen EDAC")
+        a.set_xlabel("t")
+        a.set_ylabel("max |u|")
+        a.legend()
+        b.plot(t, l1, "b-")
+        b.set_xlabel("t")
+        b.set_ylabel("$L_1$ error of |u| (seed 002 eq. 66)")
+        fig.tight_layout()
+        fig.savefig(os.path.join(outdir, "decay.png"), dpi=100)
+        plt.close(fig)

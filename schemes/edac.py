@@ -1,0 +1,133 @@
+"""Weakly compressible EDAC scheme: the uncorrected baseline of seed 002 (sections 2-3).
+
+Summation density, EDAC pressure (eq. 22 discretised as eq. 26 without the CTVF
+corrections), momentum with pressure gradient, Morris viscosity and optional
+artificial viscosity (eqs. 27-29), kick-drift-kick integration (eqs. 54-60).  With
+``pst='sun2019'`` particles move with the transport velocity u~ = u + dt/2 (du/dt)_c
+of the Sun et al. shifting acceleration (eq. 36, 55) and the momentum equation keeps
+the TVF stress term; the corrections C1-C3 of CTVF are not applied (digest A10).
+"""
+from sphgen.equation import Group
+from sphgen.integrators import IntegratorStep, KickDriftKick
+from sphgen.kernels import get_kernel
+from sphgen.scheme import Scheme
+
+from ..equations.basic import SummationDensity, Vorticity2D
+from ..equations.edac import EDACPressureRate
+from ..equations.momentum import (ArtificialViscosity, AveragePressure, LaminarViscosity,
+                                 PressureGradient)
+from ..equations.transport import (BackgroundPressureAcceleration, SunShiftingAcceleration,
+                                  TransportStress)
+
+PSTS = ("none", "sun2019", "tvf")
+
+
+class EDACStep(IntegratorStep):
+    """Kick-drift-kick stages of seed 002 eqs. 54-60 (``shift``: move with u~)."""
+
+    switches = ("dim", "shift")
+
+    def __init__(self, dim, shift):
+        self.dim, self.shift = dim, int(shift)
+
+    def stage1(self, d_idx, d_u, d_v, d_w, d_au, d_av, d_aw, d_uhat, d_vhat, d_what,
+               d_auhat, d_avhat, d_awhat, dt):
+        """Kick (eq. 54) and transport velocity (eq. 55)."""
+        d_u[d_idx] += 0.5 * dt * d_au[d_idx]
+        d_v[d_idx] += 0.5 * dt * d_av[d_idx]
+        if self.dim > 2:
+            d_w[d_idx] += 0.5 * dt * d_aw[d_idx]
+        if self.shift:
+            d_uhat[d_idx] = d_u[d_idx] + 0.5 * dt * d_auhat[d_idx]
+            d_vhat[d_idx] = d_v[d_idx] + 0.5 * dt * d_avhat[d_idx]
+            if self.dim > 2:
+                d_what[d_idx] = d_w[d_idx] + 0.5 * dt * d_awhat[d_idx]
+
+    def stage2(self, d_idx, d_x, d_y, d_z, d_u, d_v, d_w, d_uhat, d_vhat, d_what, d_p, d_ap, dt):
+        """Drift: pressure (eq. 57) and positions (eq. 59)."""
+        d_p[d_idx] += dt * d_ap[d_idx]
+        if self.shift:
+            d_x[d_idx] += dt * d_uhat[d_idx]
+            d_y[d_idx] += dt * d_vhat[d_idx]
+            if self.dim > 2:
+                d_z[d_idx] += dt * d_what[d_idx]
+        else:
+            d_x[d_idx] += dt * d_u[d_idx]
+            d_y[d_idx] += dt * d_v[d_idx]
+            if self.dim > 2:
+                d_z[d_idx] += dt * d_w[d_idx]
+
+    def stage3(self, d_idx, d_u, d_v, d_w, d_au, d_av, d_aw, dt):
+        """Kick (eq. 60)."""
+        d_u[d_idx] += 0.5 * dt * d_au[d_idx]
+        d_v[d_idx] += 0.5 * dt * d_av[d_idx]
+        if self.dim > 2:
+            d_w[d_idx] += 0.5 * dt * d_aw[d_idx]
+
+
+class EDACScheme(Scheme):
+    """EDAC for fluids without walls (periodic or open), seed 002 uncorrected baseline."""
+
+    output_props = ("x", "y", "z", "u", "v", "w", "p", "rho", "m", "h")
+
+    def __init__(self, fluids, dim, rho0, c0, nu, h, dx, umax=1.0, pst="none", alpha=0.0,
+                 alpha_edac=0.5, mach=None, pb=None, bql=True, kernel="quintic"):
+        if pst not in PSTS:
+            raise ValueError(f"pst must be one of {', '.join(PSTS)}; got {pst!r}")
+        for name, v in (("rho0", rho0), ("c0", c0), ("h", h), ("dx", dx), ("umax", umax)):
+            if not v > 0:
+                raise ValueError(f"EDACScheme: {name}={v!r} must be > 0")
+        if not nu >= 0:
+            raise ValueError(f"EDACScheme: nu={nu!r} must be >= 0")
+        self.fluids, self.dim = list(fluids), dim
+        self.rho0, self.c0, self.nu, self.h, self.dx, self.umax = rho0, c0, nu, h, dx, umax
+        self.pst, self.alpha, self.alpha_edac = pst, alpha, alpha_edac
+        self.mach = umax / c0 if mach is None else mach
+        # the KDK transport velocity u + dt/2 a_c (seed 002 eq. 55) with p_b = 2 rho0 c0^2
+        # equals Adami et al.'s u + dt a_c with their p_b = rho0 c0^2
+        self.pb = 2.0 * rho0 * c0 * c0 if pb is None else pb
+        self.bql = bool(bql)
+        self.kernel = get_kernel(kernel, dim)
+        skip = {1: ("y", "z", "v", "w"), 2: ("z", "w"), 3: ()}[dim]
+        self.output_props = tuple(p for p in self.output_props if p not in skip)
+
+    def setup_properties(self, arrays):
+        for pa in arrays:
+            for p in ("p", "ap", "pavg", "nnbr", "au", "av", "aw", "uhat", "vhat", "what", "auhat", "avhat", "awhat", "omega"):
+                pa.add_property(p)
+
+    def get_equations(self):
+        f = self.fluids
+        nu_edac = self.alpha_edac * self.h * self.c0 / 8.0  # seed 002 eq. 24
+        shift = self.pst != "none"
+        pressure = [Group([EDACPressureRate(d, f, c0=self.c0, nu_edac=nu_edac) for d in f])]
+        momentum = []
+        for d in f:
+            momentum += [PressureGradient(d, f, bql=self.bql),
+                         LaminarViscosity(d, f, nu=self.nu),
+                         ArtificialViscosity(d, f, alpha=self.alpha, c0=self.c0)]
+            if shift:
+                momentum.append(TransportStress(d, f))
+            if self.pst == "sun2019":
+                wdx = self.kernel.w(self.dx, self.h)
+                momentum.append(SunShiftingAcceleration(d, f, mach=self.mach, c0=self.c0, wdx=wdx))
+            elif self.pst == "tvf":
+                momentum.append(BackgroundPressureAcceleration(d, f, pb=self.pb))
+            if self.dim == 2:
+                momentum.append(Vorticity2D(d, f))
+        density = [SummationDensity(d, f) for d in f]
+        if self.bql:
+            density += [AveragePressure(d, f) for d in f]
+        density = Group(density)
+        return [pressure, [density, Group(momentum)]]
+
+    def get_integrator(self):
+        step = EDACStep(self.dim, self.pst != "none")
+        return KickDriftKick(**{name: step for name in self.fluids})
+
+    def get_timestep(self):
+        """Seed 002 eq. 61: min(0.25 h/(c0 + U), 0.25 h^2/nu)."""
+        dt = 0.25 * self.h / (self.c0 + self.umax)
+        if self.nu > 0:
+            dt = min(dt, 0.25 * self.h * self.h / self.nu)
+        return dt
