@@ -21,10 +21,11 @@ class AveragePressure(Equation):
 class PressureGradient(Equation):
     """du_a/dt = -sum_b m_b (p_a/rho_a^2 + p_b/rho_b^2) grad W_ab (seed 002 eq. 27, first term).
 
-    With ``bql`` the pair's mean local pressure (p_avg,a + p_avg,b)/2 is subtracted
-    from p_a and p_b (after Basa, Quinlan & Lastiwka 2009; symmetric in a and b so
-    linear momentum is conserved exactly), which removes the tensile instability of
-    negative absolute pressures.  Initialises the acceleration, so it comes first.
+    With ``bql`` the destination's local mean pressure p_avg,a is subtracted from p_a
+    and p_b (Basa, Quinlan & Lastiwka 2009), which removes the tensile instability of
+    negative absolute pressures; the pair force is then not exactly antisymmetric, so
+    linear momentum is conserved to round-off only with ``bql`` off (docs/schemes).
+    Initialises the acceleration, so it comes first.
     """
 
     switches = ("bql",)
@@ -34,10 +35,10 @@ class PressureGradient(Equation):
         d_av[d_idx] = 0.0
         d_aw[d_idx] = 0.0
 
-    def loop(self, d_idx, d_au, d_av, d_aw, d_p, d_pavg, d_rho, s_idx, s_m, s_p, s_pavg, s_rho, DWIJ):
+    def loop(self, d_idx, d_au, d_av, d_aw, d_p, d_pavg, d_rho, s_idx, s_m, s_p, s_rho, DWIJ):
         pref = 0.0
         if self.bql:
-            pref = 0.5 * (d_pavg[d_idx] + s_pavg[s_idx])
+            pref = d_pavg[d_idx]
         pa = (d_p[d_idx] - pref) / (d_rho[d_idx] * d_rho[d_idx])
         pb = (s_p[s_idx] - pref) / (s_rho[s_idx] * s_rho[s_idx])
         f = -s_m[s_idx] * (pa + pb)
