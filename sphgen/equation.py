@@ -16,6 +16,8 @@ GHIJ, EPS``) are computed only when a ``loop`` asks for them.  Pair loops write 
 """
 import math
 
+from compyle.api import declare  # noqa: F401  (re-exported: ``from sphgen.equation import declare``)
+
 PAIR_SYMBOLS = ("XIJ", "RIJ", "R2IJ", "VIJ", "HIJ", "WIJ", "DWIJ", "WDASHIJ", "GHIJ", "EPS")
 VECTOR_SYMBOLS = ("XIJ", "VIJ", "DWIJ")
 SPECIAL_ARGS = ("d_idx", "s_idx", "t", "dt", "NBRS", "N_NBRS")

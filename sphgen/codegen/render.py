@@ -1,5 +1,6 @@
 """Render a :class:`Plan` into the Cython source of one scene module (mako)."""
 import ast
+import inspect
 import os
 import types
 
@@ -45,8 +46,7 @@ def pair_symbol_code(syms, dest, src, dim, domain, reference):
                     half = repr(0.5 * float(domain.length[k]))
                     lines += [f"if XIJ[{k}] > {half}:", f"    XIJ[{k}] -= {L}",
                               f"elif XIJ[{k}] < -{half}:", f"    XIJ[{k}] += {L}"]
-            else:
-                lines.append(f"XIJ[{k}] = 0.0")
+
     if "R2IJ" in need:
         lines.append("R2IJ = " + " + ".join(f"XIJ[{k}] * XIJ[{k}]" for k in range(dim)))
     if "RIJ" in need:
@@ -56,8 +56,8 @@ def pair_symbol_code(syms, dest, src, dim, domain, reference):
     if "EPS" in need:
         lines.append("EPS = 0.01 * HIJ * HIJ")
     if "VIJ" in need:
-        for k, u in enumerate(("u", "v", "w")):
-            lines.append(f"VIJ[{k}] = {dest}_{u}[d_idx] - {src}_{u}[s_idx]" if k < dim else f"VIJ[{k}] = 0.0")
+        for k, u in enumerate(("u", "v", "w")[:dim]):
+            lines.append(f"VIJ[{k}] = {dest}_{u}[d_idx] - {src}_{u}[s_idx]")
     if "WIJ" in need:
         lines.append("WIJ = kernel_w(RIJ, HIJ)")
     if "WDASHIJ" in need:
@@ -66,7 +66,7 @@ def pair_symbol_code(syms, dest, src, dim, domain, reference):
         lines.append("GHIJ = kernel_gradh(RIJ, HIJ)")
     if "DWIJ" in need:
         lines.append("_f = WDASHIJ / RIJ if RIJ > 1e-12 else 0.0")
-        lines += [f"DWIJ[{k}] = _f * XIJ[{k}]" for k in range(3)]
+        lines += [f"DWIJ[{k}] = _f * XIJ[{k}]" for k in range(dim)]
     return lines
 
 
@@ -90,14 +90,21 @@ def _call(sp, dest, src=None, key=None):
     return f"{sp.fdef.name}({', '.join(args)})"
 
 
+_COMPYLE_BUILTINS = ("declare", "cast", "address", "atomic_inc", "atomic_dec")
+
+
 def _helpers_called(spec, owner_func, seen):
     """Helper functions (``@helper``) called by a specialised body, recursively."""
     out = []
-    glb = getattr(owner_func, "__globals__", {})
+    glb = dict(getattr(owner_func, "__globals__", {}))
+    try:
+        glb.update(inspect.getclosurevars(owner_func).nonlocals)
+    except (TypeError, ValueError):
+        pass
     for node in ast.walk(spec.fdef):
         if isinstance(node, ast.Call) and isinstance(node.func, ast.Name):
             f = glb.get(node.func.id)
-            if isinstance(f, types.FunctionType):
+            if isinstance(f, types.FunctionType) and node.func.id not in _COMPYLE_BUILTINS:
                 if not getattr(f, "__sphgen_helper__", False):
                     raise TranslationError(
                         f"{node.func.id}() is a Python function, not a sphgen helper: decorate it "
@@ -165,7 +172,11 @@ def render(plan):
                     syms_all |= {ln.split(" = ")[0].split("[")[0] for ln in symbols if " = " in ln}
                     p.sources.append(_Obj(name=src, key=key, symbols=symbols, calls=calls, loop_all=alls))
                 decls = ["cdef long s_idx = 0", "cdef long _k = 0", "cdef double _f = 0.0"]
-                decls += [f"cdef double {s}[3]" for s in ("XIJ", "VIJ", "DWIJ") if s in syms_all]
+                for s in ("XIJ", "VIJ", "DWIJ"):
+                    if s in syms_all:
+                        # components past the dimension are zero (set once, never recomputed)
+                        decls.append(f"cdef double {s}[3]")
+                        decls += [f"{s}[{k}] = 0.0" for k in range(plan.dim, 3)]
                 scal = [s for s in ("RIJ", "R2IJ", "HIJ", "EPS", "WIJ", "WDASHIJ", "GHIJ") if s in syms_all]
                 decls += [f"cdef double {s} = 0.0" for s in scal]
                 p.decls = decls

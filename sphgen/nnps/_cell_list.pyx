@@ -49,6 +49,7 @@ ctypedef struct Grid:
     int dim              # number of coordinates that count
     double lo[3]         # lower corner of cell (0, 0, 0)
     double cs[3]         # cell edge along each axis
+    double inv_cs[3]     # 1 / cs
     double length[3]     # box length along periodic axes
     double half[3]       # length / 2
     int n[3]             # cells along each axis (1 for unused axes)
@@ -105,6 +106,7 @@ cdef class GridSpec:
                 raise ValueError(f"axis {a}: need n >= 1 and cell size > 0")
             self.c.lo[a] = lo[a]
             self.c.cs[a] = cs[a]
+            self.c.inv_cs[a] = 1.0 / cs[a]
             self.c.length[a] = length[a]
             self.c.half[a] = 0.5 * length[a]
             self.c.n[a] = n[a]
@@ -149,11 +151,12 @@ cdef inline int* _iptr(int[::1] v) noexcept:
 # ------------------------------------------------------------ scalar helpers
 
 cdef inline int _cell_coord(const Grid* g, int a, double x) noexcept nogil:
-    """Cell coordinate of ``x`` along axis ``a``, clamped into the grid."""
+    """Cell coordinate of ``x`` along axis ``a``, clamped into the grid.  (Rounding
+    may put a particle a hair outside its cell; distances are exact regardless.)"""
     cdef double t
     if a >= g.dim:
         return 0
-    t = (x - g.lo[a]) / g.cs[a]
+    t = (x - g.lo[a]) * g.inv_cs[a]
     if not (t >= 0.0):          # also catches NaN
         return 0
     if t >= g.n[a] - 1:

@@ -1,0 +1,31 @@
+"""Kernel identities: normalisation, derivatives, and the compiled kernel == Python."""
+import numpy as np
+import pytest
+
+from sphgen.kernels import QuinticSpline, get_kernel
+
+
+@pytest.mark.parametrize("dim", [1, 2, 3])
+def test_quintic_normalisation(dim):
+    k = QuinticSpline(dim)
+    r = np.linspace(0.0, 3.0, 30001)
+    w = np.array([k.w(x, 1.0) for x in r])
+    surface = {1: 2.0, 2: 2 * np.pi * r, 3: 4 * np.pi * r ** 2}[dim]
+    assert abs(np.trapezoid(w * surface, r) - 1.0) < 1e-6
+
+
+@pytest.mark.parametrize("dim", [1, 2, 3])
+def test_quintic_derivatives_match_finite_differences(dim):
+    k = QuinticSpline(dim)
+    h, e = 0.7, 1e-6
+    for r in np.linspace(0.05, 2.95, 40):
+        fd = (k.w(r + e, h) - k.w(r - e, h)) / (2 * e)
+        assert abs(k.dwdr(r, h) - fd) < 1e-6 * max(1.0, abs(fd)) / h ** (dim + 1)
+        fdh = h * (k.w(r, h + e) - k.w(r, h - e)) / (2 * e)
+        assert abs(k.gradh(r, h) - fdh) < 1e-5 / h ** dim
+    assert k.w(3.0 * h, h) == 0.0 and k.dwdr(3.0 * h, h) == 0.0
+
+
+def test_unknown_kernel_is_a_clear_error():
+    with pytest.raises(ValueError, match="unknown kernel 'cubic'; known: quintic"):
+        get_kernel("cubic", 2)
