@@ -29,6 +29,25 @@ class SceneError(ValueError):
     """A scene is inconsistent: missing property, bad array name, race, ..."""
 
 
+def _reduce_reads(eq):
+    """Properties ``reduce(self, dst, t, dt)`` reads as ``dst.<name>`` (found in its source)."""
+    import ast
+    import inspect
+    import textwrap
+    try:
+        tree = ast.parse(textwrap.dedent(inspect.getsource(type(eq).reduce)))
+    except (OSError, TypeError, SyntaxError):
+        return set()
+    fdef = tree.body[0]
+    args = [a.arg for a in fdef.args.args]
+    if len(args) < 2:
+        return set()
+    dst = args[1]
+    return {(eq.dest, n.attr) for n in ast.walk(fdef)
+            if isinstance(n, ast.Attribute) and isinstance(n.value, ast.Name) and n.value.id == dst
+            and not n.attr.startswith("_") and n.attr not in ("n", "name", "data", "props", "constants")}
+
+
 class EqPlan:
     """One equation instance: its specialised methods and whether it is kept."""
 
@@ -43,6 +62,7 @@ class EqPlan:
         self.kept = True
         self.reason = ""
         self.python_hooks = [m for m in ("reduce", "converged") if callable(getattr(eq, m, None))]
+        self.python_reads = _reduce_reads(eq) if "reduce" in self.python_hooks else set()
 
     def implied(self):
         """Properties the requested pair symbols need, on dest and sources."""
@@ -236,7 +256,7 @@ class Plan:
                     if id(ep.eq) not in live:
                         live.add(id(ep.eq))
                         changed = True
-                    new = ep.reads() - needed
+                    new = (ep.reads() | ep.python_reads) - needed
                     if new:
                         needed |= new
                         changed = True

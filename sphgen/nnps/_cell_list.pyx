@@ -54,8 +54,9 @@ ctypedef struct Grid:
     double half[3]       # length / 2
     int n[3]             # cells along each axis (1 for unused axes)
     int periodic[3]      # 1 if the axis is periodic
-    int all_cells[3]     # periodic axis with < 3 cells: visit every cell, pair image
+    int all_cells[3]     # periodic axis with < 2m+1 cells: visit every cell, pair image
     int any_all_cells    # some axis has all_cells
+    int m                # cells per cut-off: neighbours are within m cells
     const int* rank      # linear cell index -> storage rank
     const int* unrank    # storage rank -> linear cell index
 
@@ -67,12 +68,18 @@ ctypedef struct Bins:
     Py_ssize_t n
 
 
+cdef enum:
+    MAX_M = 2                           # largest subdivision m
+    MAX_AXIS = 2 * MAX_M + 1            # stencil width per axis
+    MAX_CELLS = MAX_AXIS * MAX_AXIS * MAX_AXIS
+
+
 ctypedef struct Stencil:
-    int nc               # number of neighbour cells
-    int cells[27]        # their ranks, ascending
-    double shift[27][3]  # image shift added to x_i - x_j for each cell
-    int side[27][3]      # 0: cell below on that axis, 2: above, 1: same/unprunable
-    double corner[3]     # lower corner of the centre cell
+    int nc                       # number of neighbour cells
+    int cells[MAX_CELLS]         # their ranks, ascending
+    double shift[MAX_CELLS][3]   # image shift added to x_i - x_j for each cell
+    int off[MAX_CELLS][3]        # offset from the centre cell, m + (-m..m); m if unprunable
+    double corner[3]             # lower corner of the centre cell
 
 
 ctypedef struct Row:
@@ -87,18 +94,23 @@ cdef class GridSpec:
     ``lo``, ``cs`` (cell edges), ``length`` (periodic box lengths), ``n`` (cells) and
     ``periodic`` are length-3 sequences (unused axes: ``n = 1``); ``rank`` is an
     int32 array of ``prod(n)`` entries, the storage rank of each linear cell index.
+    ``m``: the cell edges are at least cut-off / m, so neighbours are at most ``m``
+    cells apart (1 or 2).
     """
     cdef Grid c
     cdef int[::1] _rank
     cdef int[::1] _unrank
     cdef readonly Py_ssize_t ncells
 
-    def __init__(self, int dim, lo, cs, length, n, periodic, int[::1] rank):
+    def __init__(self, int dim, lo, cs, length, n, periodic, int[::1] rank, int m=1):
         cdef int a
         cdef Py_ssize_t i
         if dim < 1 or dim > 3:
             raise ValueError(f"dim must be 1, 2 or 3, got {dim}")
+        if m < 1 or m > MAX_M:
+            raise ValueError(f"m must be 1..{MAX_M}, got {m}")
         self.c.dim = dim
+        self.c.m = m
         self.c.any_all_cells = 0
         self.ncells = 1
         for a in range(3):
@@ -111,7 +123,7 @@ cdef class GridSpec:
             self.c.half[a] = 0.5 * length[a]
             self.c.n[a] = n[a]
             self.c.periodic[a] = 1 if (periodic[a] and a < dim) else 0
-            self.c.all_cells[a] = 1 if (self.c.periodic[a] and n[a] < 3) else 0
+            self.c.all_cells[a] = 1 if (self.c.periodic[a] and n[a] < 2 * m + 1) else 0
             self.c.any_all_cells |= self.c.all_cells[a]
             self.ncells *= n[a]
         if rank.shape[0] != self.ncells:
@@ -174,24 +186,25 @@ cdef inline double _min_image(const Grid* g, int a, double d) noexcept nogil:
 
 
 cdef int _axis_candidates(const Grid* g, int a, int c, int* out, double* shift,
-                          int* side) noexcept nogil:
+                          int* off) noexcept nogil:
     """Distinct cell coordinates along axis ``a`` that may hold neighbours of cell
-    ``c``; for each, the image shift to add to ``x_i - x_j`` and the side (0 below,
-    1 same or not prunable, 2 above).  Returns the count."""
-    cdef int m = 0, k, q
+    ``c``; for each, the image shift to add to ``x_i - x_j`` and the offset
+    ``m + (q - c)`` (``m``, i.e. zero distance, where it cannot prune).  Returns the
+    count (at most ``2m + 1``)."""
+    cdef int nout = 0, k, q
     cdef double s
     if a >= g.dim:
         out[0] = 0
         shift[0] = 0.0
-        side[0] = 1
+        off[0] = g.m
         return 1
     if g.all_cells[a]:          # pair-by-pair minimum image instead of a shift
         for k in range(g.n[a]):
             out[k] = k
             shift[k] = 0.0
-            side[k] = 1
+            off[k] = g.m
         return g.n[a]
-    for k in range(-1, 2):
+    for k in range(-g.m, g.m + 1):
         q = c + k
         s = 0.0
         if q < 0:
@@ -204,11 +217,11 @@ cdef int _axis_candidates(const Grid* g, int a, int c, int* out, double* shift,
                 continue
             q -= g.n[a]
             s = -g.length[a]    # ... at x + L
-        out[m] = q
-        shift[m] = s
-        side[m] = k + 1
-        m += 1
-    return m
+        out[nout] = q
+        shift[nout] = s
+        off[nout] = k + g.m
+        nout += 1
+    return nout
 
 
 cdef void _swap_cells(Stencil* st, int p, int q) noexcept nogil:
@@ -221,17 +234,17 @@ cdef void _swap_cells(Stencil* st, int p, int q) noexcept nogil:
         td = st.shift[p][a]
         st.shift[p][a] = st.shift[q][a]
         st.shift[q][a] = td
-        ti = st.side[p][a]
-        st.side[p][a] = st.side[q][a]
-        st.side[q][a] = ti
+        ti = st.off[p][a]
+        st.off[p][a] = st.off[q][a]
+        st.off[q][a] = ti
 
 
 cdef void _stencil(const Grid* g, int rank, Stencil* st) noexcept nogil:
-    """The (at most 27, distinct) cells around the cell of rank ``rank``, sorted by
-    rank, with their image shifts and sides; and the cell's lower corner."""
-    cdef int cand[3][3]
-    cdef double sh[3][3]
-    cdef int sd[3][3]
+    """The (at most (2m+1)**3, distinct) cells around the cell of rank ``rank``,
+    sorted by rank, with their image shifts and offsets; and the cell's corner."""
+    cdef int cand[3][MAX_AXIS]
+    cdef double sh[3][MAX_AXIS]
+    cdef int sd[3][MAX_AXIS]
     cdef int m[3]
     cdef int c[3]
     cdef int a, p, q, r, lin = g.unrank[rank]
@@ -249,11 +262,11 @@ cdef void _stencil(const Grid* g, int rank, Stencil* st) noexcept nogil:
                 st.shift[st.nc][0] = sh[0][p]
                 st.shift[st.nc][1] = sh[1][q]
                 st.shift[st.nc][2] = sh[2][r]
-                st.side[st.nc][0] = sd[0][p]
-                st.side[st.nc][1] = sd[1][q]
-                st.side[st.nc][2] = sd[2][r]
+                st.off[st.nc][0] = sd[0][p]
+                st.off[st.nc][1] = sd[1][q]
+                st.off[st.nc][2] = sd[2][r]
                 st.nc += 1
-    for p in range(1, st.nc):       # insertion sort by rank (<= 27 cells)
+    for p in range(1, st.nc):       # insertion sort by rank (<= 125 cells)
         q = p
         while q > 0 and st.cells[q - 1] > st.cells[q]:
             _swap_cells(st, q - 1, q)
@@ -393,23 +406,21 @@ cdef int _reserve(Row* buf, Py_ssize_t extra) noexcept nogil:
     return 0
 
 
-cdef inline bint _out_of_reach(const Stencil* st, int c, const double* xi,
-                               const double* cs, double reach2) noexcept nogil:
-    """True if every point of neighbour cell ``c`` is at least ``sqrt(reach2)`` from
-    ``xi`` (squared distance from the point to the cell box, per axis the gap to the
-    face of the centre cell on that side)."""
-    cdef double gap, d2 = 0.0
-    cdef int a
+cdef void _gaps(const Grid* g, const Stencil* st, const double* xi,
+               double gap2[3][MAX_AXIS]) noexcept nogil:
+    """``gap2[a][m + k]``: squared distance along axis ``a`` from ``xi`` to the cells
+    ``k`` cells away from the centre cell (0 for ``k = 0``)."""
+    cdef int a, k
+    cdef double below, above, gap
     for a in range(3):
-        if st.side[c][a] == 0:
-            gap = xi[a] - st.corner[a]
-        elif st.side[c][a] == 2:
-            gap = st.corner[a] + cs[a] - xi[a]
-        else:
-            continue
-        if gap > 0.0:
-            d2 += gap * gap
-    return d2 >= reach2
+        below = xi[a] - st.corner[a]
+        above = st.corner[a] + g.cs[a] - xi[a]
+        gap2[a][g.m] = 0.0
+        for k in range(1, g.m + 1):
+            gap = below + (k - 1) * g.cs[a]
+            gap2[a][g.m - k] = gap * gap if gap > 0.0 else 0.0
+            gap = above + (k - 1) * g.cs[a]
+            gap2[a][g.m + k] = gap * gap if gap > 0.0 else 0.0
 
 
 cdef int _block_rows(const Grid* g, const Bins* d, const Bins* s, double reach2_s,
@@ -421,6 +432,7 @@ cdef int _block_rows(const Grid* g, const Bins* d, const Bins* s, double reach2_
     rows come out ascending (cells are visited by rank).  Returns 0, or -1 if out
     of memory."""
     cdef Stencil st
+    cdef double gap2[3][MAX_AXIS]
     cdef int c, r, i
     cdef Py_ssize_t p, upper, cnt
     cdef const double* xi
@@ -438,11 +450,13 @@ cdef int _block_rows(const Grid* g, const Bins* d, const Bins* s, double reach2_
                 return -1
             xi = d.pts + 4 * p
             reach2 = (xi[3] if xi[3] > reach2_s else reach2_s) * _REACH_MARGIN
+            _gaps(g, &st, xi, gap2)
             out = buf.data + buf.used
             cnt = 0
             for c in range(st.nc):
-                if _out_of_reach(&st, c, xi, g.cs, reach2):
-                    continue
+                if (gap2[0][st.off[c][0]] + gap2[1][st.off[c][1]]
+                        + gap2[2][st.off[c][2]]) >= reach2:
+                    continue        # every point of the cell is out of reach
                 if g.any_all_cells:
                     cnt += _scan_cell_pair_image(g, xi, s, st.cells[c], st.shift[c], out + cnt)
                 else:

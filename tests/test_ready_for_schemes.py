@@ -1,0 +1,206 @@
+"""Core features the schemes build on, each compiled and checked quantitatively."""
+import numpy as np
+import pytest
+
+from sphgen.equation import Equation, Group, declare
+from sphgen.integrators import EPEC, IntegratorStep
+from sphgen.linalg import inv3, matmul3
+from sphgen.scene import Scene
+from sphgen.equations.basic import SummationDensity
+
+from conftest import lattice_cloud, periodic_box
+
+
+class RenormalisedVelocityGradient(Equation):
+    """grad u_a = [sum_b m_b u_ab (x) grad W_ab] [sum_b m_b x_ab (x) grad W_ab]^-1."""
+
+    def initialize(self, d_idx, d_L, d_H):
+        for i in range(9):
+            d_L[9 * d_idx + i] = 0.0
+            d_H[9 * d_idx + i] = 0.0
+
+    def loop(self, d_idx, d_L, d_H, s_idx, s_m, VIJ, XIJ, DWIJ):
+        for i in range(3):
+            for j in range(3):
+                d_L[9 * d_idx + 3 * i + j] += s_m[s_idx] * VIJ[i] * DWIJ[j]
+                d_H[9 * d_idx + 3 * i + j] += s_m[s_idx] * XIJ[i] * DWIJ[j]
+
+    def post_loop(self, d_idx, d_L, d_H, d_gradv):
+        h = declare("matrix(9)")
+        hi = declare("matrix(9)")
+        lm = declare("matrix(9)")
+        g = declare("matrix(9)")
+        for i in range(9):
+            h[i] = d_H[9 * d_idx + i]
+            lm[i] = d_L[9 * d_idx + i]
+        inv3(h, hi)
+        matmul3(lm, hi, g)
+        for i in range(9):
+            d_gradv[9 * d_idx + i] = g[i]
+
+
+@pytest.mark.parametrize("backend", ["cython", "python"])
+def test_renormalised_velocity_gradient_is_exact_for_linear_fields(backend):
+    pa = lattice_cloud(nx=6, dim=3, jitter=0.3, seed=5)
+    G = np.array([[0.3, -1.2, 0.5], [2.0, 0.1, -0.7], [-0.4, 0.9, 1.1]])
+    X = np.stack([pa.x, pa.y, pa.z], axis=1)
+    U = X @ G.T + np.array([0.2, -0.1, 0.3])
+    pa.u, pa.v, pa.w = U[:, 0], U[:, 1], U[:, 2]
+    for p in ("L", "H", "gradv"):
+        pa.add_property(p, stride=9)
+    sc = Scene([pa], [RenormalisedVelocityGradient("fluid", ["fluid"])], dim=3,
+               outputs={"fluid": ["gradv"]}, backend=backend)
+    sc.compute(0, 0.0, 0.1)
+    grad = pa.gradv.reshape(-1, 3, 3)
+    err = np.abs(grad - G).max() / np.abs(G).max()
+    assert err < 1e-12, err
+
+
+class ReferenceSum(Equation):
+    """rho0_a = sum_b m_b W(X_ab) on the reference configuration; counts neighbours."""
+
+    def initialize(self, d_idx, d_rho0):
+        d_rho0[d_idx] = 0.0
+
+    def loop(self, d_idx, d_rho0, s_idx, s_m, WIJ):
+        d_rho0[d_idx] += s_m[s_idx] * WIJ
+
+    def loop_all(self, d_idx, d_nref, NBRS, N_NBRS):
+        d_nref[d_idx] = N_NBRS
+
+
+def test_reference_neighbour_lists_stay_fixed_while_particles_move():
+    pa = lattice_cloud(nx=10, jitter=0.1, seed=2)
+    for p in ("x0", "y0"):
+        pa.add_property(p, data=pa.get(p[0]).copy())
+    pa.add_property("rho0")
+    pa.add_property("nref")
+    eqs = [Group([ReferenceSum("fluid", ["fluid"])], reference=True),
+           Group([SummationDensity("fluid", ["fluid"])])]
+    sc = Scene([pa], eqs, dim=2, outputs={"fluid": ["rho0", "rho", "nref"]})
+    sc.compute(0, 0.0, 0.1)
+    rho0, nref, rho = pa.rho0.copy(), pa.nref.copy(), pa.rho.copy()
+    assert np.allclose(rho0, rho, rtol=1e-14)          # same configuration at t = 0
+    rng = np.random.default_rng(0)
+    pa.x[:] += 0.05 * rng.standard_normal(pa.n)       # move far: a quarter of the support
+    pa.y[:] += 0.05 * rng.standard_normal(pa.n)
+    sc.update_nnps()
+    sc.compute(0, 0.0, 0.1)
+    assert np.array_equal(pa.nref, nref)              # neighbours fixed at t = 0
+    assert np.allclose(pa.rho0, rho0, rtol=1e-14)     # pair geometry from x0, y0
+    assert np.abs(pa.rho - rho).max() > 1e-2          # the current configuration did change
+    off, _ = sc.nnps.neighbours("fluid", "fluid")
+    assert not np.array_equal(np.diff(off), nref.astype(np.int32))
+
+
+class FixedPoint(Equation):
+    """x <- cos(x) per particle; converged when the largest change is below tol."""
+
+    def __init__(self, dest, tol):
+        super().__init__(dest, None, tol=tol)
+        self.change = np.inf
+
+    def initialize(self, d_idx, d_xk, d_dxk):
+        xn = cos(d_xk[d_idx])  # noqa: F821  (libc cos in C, math.cos below)
+        d_dxk[d_idx] = abs(xn - d_xk[d_idx])
+        d_xk[d_idx] = xn
+
+    def reduce(self, dst, t, dt):
+        self.change = float(dst.dxk.max())
+
+    def converged(self):
+        return 1 if self.change < self.tol else -1
+
+
+def test_iterated_group_stops_on_converged_and_reports_iterations():
+    import math
+    import builtins
+    builtins.cos = math.cos  # the Python evaluator's cos; C uses libc's
+    try:
+        pa = lattice_cloud(nx=4)
+        pa.add_property("xk", data=np.linspace(-1.0, 1.0, pa.n))
+        pa.add_property("dxk")
+        g = Group([FixedPoint("fluid", tol=1e-13)], iterate=True, max_iterations=500)
+        sc = Scene([pa], [g], dim=2, outputs={"fluid": ["xk"]})
+        x0 = pa.xk.copy()
+        sc.compute(0, 0.0, 0.1)
+    finally:
+        del builtins.cos
+    assert np.allclose(pa.xk, 0.7390851332151607, atol=1e-12)
+    # the same iteration in numpy takes the same number of sweeps
+    x, n = x0, 0
+    while True:
+        xn = np.cos(x)
+        n += 1
+        done = np.abs(xn - x).max() < 1e-13
+        x = xn
+        if done:
+            break
+    assert g.iterations == n and 10 < n < 500
+
+
+class CountA(Equation):
+    def initialize(self, d_idx, d_ca):
+        d_ca[d_idx] += 1.0
+
+
+class CountB(Equation):
+    def initialize(self, d_idx, d_cb, d_rho):
+        d_cb[d_idx] += 1.0 + 0.0 * d_rho[d_idx]
+
+
+class Drift(IntegratorStep):
+    def stage1(self, d_idx, d_x, d_u, dt):
+        d_x[d_idx] += 0.5 * dt * d_u[d_idx]
+
+    def stage2(self, d_idx, d_x, d_u, d_ca, d_cb, dt):
+        d_x[d_idx] += 0.5 * dt * d_u[d_idx] + 0.0 * (d_ca[d_idx] + d_cb[d_idx])
+
+
+def test_epec_runs_different_sets_per_evaluation_and_updates_neighbours_twice():
+    pa = lattice_cloud(nx=8)
+    pa.add_property("ca", default=0.0)
+    pa.add_property("cb", default=0.0)
+    integ = EPEC(fluid=Drift())
+    sets = [[Group([CountA("fluid")])], [Group([SummationDensity("fluid", ["fluid"])]),
+                                         Group([CountB("fluid")])]]
+    sc = Scene([pa], sets, steppers=integ.steppers, dim=2, domain=periodic_box(2),
+               outputs={"fluid": ["ca", "cb"]})
+    integ.attach(sc)
+    before = sc.nnps.n_updates
+    x0 = pa.x.copy()
+    for step in range(3):
+        integ.one_timestep(0.01 * step, 0.01)
+    assert np.all(pa.ca == 3) and np.all(pa.cb == 3)
+    assert integ.nnps_updates == 6 and sc.nnps.n_updates - before == 6
+    dx = (pa.x - x0 + 0.5) % 1.0 - 0.5
+    assert np.allclose(dx, 0.03 * pa.u, atol=1e-12)
+
+
+class RhoRange(Equation):
+    """Global min and max of rho, stored in constants for later groups."""
+
+    def initialize(self, d_idx, d_rho):
+        pass
+
+    def reduce(self, dst, t, dt):
+        dst.rhomin[0] = dst.rho.min()
+        dst.rhomax[0] = dst.rho.max()
+
+
+class Normalise(Equation):
+    def initialize(self, d_idx, d_rho, d_rhon, d_rhomin, d_rhomax):
+        d_rhon[d_idx] = (d_rho[d_idx] - d_rhomin[0]) / (d_rhomax[0] - d_rhomin[0])
+
+
+def test_min_max_reductions_between_groups():
+    pa = lattice_cloud(nx=10, jitter=0.3)
+    pa.add_constant("rhomin", 0.0)
+    pa.add_constant("rhomax", 0.0)
+    pa.add_property("rhon")
+    eqs = [Group([SummationDensity("fluid", ["fluid"]), RhoRange("fluid")]),
+           Group([Normalise("fluid")])]
+    sc = Scene([pa], eqs, dim=2, outputs={"fluid": ["rhon"]})
+    sc.compute(0, 0.0, 0.1)
+    assert pa.rhon.min() == 0.0 and pa.rhon.max() == 1.0
+    assert pa.rhomax[0] == pa.rho.max() and pa.rhomin[0] < pa.rhomax[0]
