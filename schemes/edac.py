@@ -88,6 +88,8 @@ class EDACScheme(Scheme):
         self.pb = 2.0 * rho0 * c0 * c0 if pb is None else pb
         self.bql = bool(bql)
         self.kernel = get_kernel(kernel, dim)
+        # weak compressibility assumes Mach << 1: a particle at Mach 1 means the run blew up
+        self.speed_limit = c0
         skip = {1: ("y", "z", "v", "w"), 2: ("z", "w"), 3: ()}[dim]
         self.output_props = tuple(p for p in self.output_props if p not in skip)
 

@@ -125,7 +125,8 @@ class Application:
         dt = opts.dt or self.scheme.get_timestep()
         self.solver = Solver(self.scene, integrator, dt, opts.tf, max_steps=opts.max_steps,
                              pfreq=opts.pfreq, outdir=outdir, prefix=self.name,
-                             disable_output=opts.disable_output, progress=opts.progress)
+                             disable_output=opts.disable_output, progress=opts.progress,
+                             speed_limit=getattr(self.scheme, "speed_limit", None))
         if opts.restart:
             self.solver.restart_from(opts.restart)
         self.solver.post_step_callbacks.append(self.post_step)

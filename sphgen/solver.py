@@ -22,7 +22,7 @@ class Solver:
 
     def __init__(self, scene, integrator, dt, tf, *, adaptive=False, dt_props=("dt_cfl",), cfl=1.0,
                  max_steps=None, pfreq=100, output_at_times=(), outdir=None, prefix="sphgen",
-                 disable_output=False, progress=True, guard=True):
+                 disable_output=False, progress=True, guard=True, speed_limit=None):
         if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
             raise ValueError(f"time step dt={dt!r} must be a positive finite number")
         if not (math.isfinite(tf) and tf >= 0):
@@ -45,12 +45,14 @@ class Solver:
         self.disable_output = disable_output or outdir is None
         self.progress = progress
         self.guard = guard
+        self.speed_limit = speed_limit
         self.t = 0.0
         self.step = 0
         self.post_step_callbacks = []
         self.wall_time = 0.0
         self.outputs_written = []
         self._good = None
+        self.restarted = False
 
     # ---------------------------------------------------------------- state
     def restart_from(self, path):
@@ -71,6 +73,7 @@ class Solver:
                     arr[:] = src.constants[name]
         sd = data["solver_data"]
         self.t, self.step = float(sd["t"]), int(sd["step"])
+        self.restarted = True
         self.scene.update_nnps()
 
     def _snapshot(self):
@@ -125,7 +128,10 @@ class Solver:
             os.makedirs(self.outdir, exist_ok=True)
         t_start = time.perf_counter()
         integ = self.integrator
-        integ.initial_accelerations(self.t, self.dt)
+        if not self.restarted:
+            # a restart file carries the accelerations of its step: recomputing them from
+            # the end-of-step velocities would not reproduce the uninterrupted run
+            integ.initial_accelerations(self.t, self.dt)
         if not self.disable_output and self.step == 0:
             self.outputs_written.append(self.write_output())
         bar = None
@@ -143,7 +149,16 @@ class Solver:
                     break
                 dt = self.next_dt()
                 tprev = self.t
-                integ.one_timestep(self.t, dt)
+                try:
+                    integ.one_timestep(self.t, dt)
+                except ValueError:
+                    # e.g. the neighbour search met a non-finite position mid-step
+                    bad = self.scene.check_finite() if self.guard else None
+                    if bad is None:
+                        raise
+                    self.step += 1
+                    self.t += dt
+                    self._blow_up(bad, dt)
                 self.t += dt
                 self.step += 1
                 self.last_dt = dt
@@ -151,6 +166,8 @@ class Solver:
                     bad = self.scene.check_finite()
                     if bad is not None:
                         self._blow_up(bad, dt)
+                    if self.speed_limit is not None:
+                        self._check_speed(dt)
                     self._snapshot()
                 for cb in self.post_step_callbacks:
                     cb(self)
@@ -171,10 +188,23 @@ class Solver:
             io.write_xdmf(self.outdir, self.prefix)
         return self.step
 
-    def _blow_up(self, bad, dt):
-        arr, prop, idx = bad
-        where = (f"non-finite {arr}.{prop} at particle {idx}, step {self.step} "
-                 f"(t={self.t:.6g}, dt={dt:.3g})")
+    def _check_speed(self, dt):
+        """A particle faster than the scheme's limit (e.g. Mach 1 for weak compressibility)."""
+        for pa in self.scene.arrays:
+            comps = [pa.data[u] for u in ("u", "v", "w")[:self.scene.dim] if u in pa.data]
+            if comps and pa.n:
+                speed2 = sum(c * c for c in comps)
+                i = int(np.argmax(speed2))
+                if speed2[i] > self.speed_limit ** 2:
+                    what = (f"speed {np.sqrt(speed2[i]):.3g} of {pa.name} particle {i} exceeds the "
+                            f"scheme's limit {self.speed_limit:.3g}")
+                    self._blow_up(None, dt, what)
+
+    def _blow_up(self, bad, dt, what=None):
+        if what is None:
+            arr, prop, idx = bad
+            what = f"non-finite {arr}.{prop} at particle {idx}"
+        where = f"{what}, step {self.step} (t={self.t:.6g}, dt={dt:.3g})"
         saved = ""
         if self._good is not None:
             # the arrays go back to the last good state, for post-mortem in memory and on disk

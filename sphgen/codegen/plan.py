@@ -161,12 +161,16 @@ class Plan:
             self.groups.append(list(zip(groups, gps)))
         self.steppers = [StepperPlan(a, s, i) for i, (a, s) in enumerate(sorted(steppers.items()))]
         dead = {}
+        first = True
         while True:
             self._specialise(dead)
+            if first:
+                self._check_exist()
+                first = False
             self._prune()
             new = {}
             for ep in self.eqplans:
-                if ep.kept:
+                if ep.kept and not ep.eq.keep:
                     d = {f"d_{p}" for a, p in ep.writes() if (a, p) not in self.needed}
                     if d:
                         new[id(ep.eq)] = d | dead.get(id(ep.eq), set())
@@ -283,13 +287,6 @@ class Plan:
                  if a.startswith("d_") and a != "d_idx"}
             users.append((f"{type(st.stepper).__name__}[{st.array}]", t, r))
         for who, touched, reads in users:
-            for arr, prop in sorted(touched):
-                pa = self.arrays[arr]
-                if not pa.has(prop):
-                    close = difflib.get_close_matches(prop, sorted(set(pa.props) | set(pa.constants)), n=1)
-                    hint = f"; did you mean '{close[0]}'?" if close else ""
-                    raise SceneError(f"{who} uses property '{prop}' of array '{arr}', which has no such "
-                                     f"property{hint}")
             for arr, prop in sorted(reads):
                 pa = self.arrays[arr]
                 if prop in pa.data or prop in pa.constants or (arr, prop) in writers:
@@ -303,6 +300,22 @@ class Plan:
             for p in props:
                 if not self.arrays[arr].has(p):
                     raise SceneError(f"output property '{p}' of array '{arr}' does not exist")
+
+    def _check_exist(self):
+        """Every property any equation or stage names must exist (pruned or not)."""
+        users = [(ep.name, ep.touched()) for ep in self.eqplans]
+        for st in self.steppers:
+            users.append((f"{type(st.stepper).__name__}[{st.array}]",
+                          {(st.array, a[2:]) for sp in st.stages.values() for a in sp.args
+                           if a.startswith("d_") and a != "d_idx"}))
+        for who, touched in users:
+            for arr, prop in sorted(touched):
+                pa = self.arrays[arr]
+                if not pa.has(prop):
+                    close = difflib.get_close_matches(prop, sorted(set(pa.props) | set(pa.constants)), n=1)
+                    hint = f"; did you mean '{close[0]}'?" if close else ""
+                    raise SceneError(f"{who} uses property '{prop}' of array '{arr}', which has no such "
+                                     f"property{hint}")
 
     def _check_race(self, gp):
         for dest, eps in gp.dests.items():

@@ -43,6 +43,8 @@ import numpy as np
 
 # cells are skipped only if farther than the cut-off by this factor (rounding safety)
 cdef double _REACH_MARGIN = 1.000002
+# rows up to this length are sorted by insertion, longer ones by merging runs
+cdef Py_ssize_t _SHORT_ROW = 48
 
 
 ctypedef struct Grid:
@@ -86,6 +88,8 @@ ctypedef struct Row:
     int* data            # growable buffer of one block of rows
     Py_ssize_t used
     Py_ssize_t cap
+    int* tmp             # scratch for sorting one row
+    Py_ssize_t tmp_cap
 
 
 cdef class GridSpec:
@@ -275,7 +279,38 @@ cdef void _stencil(const Grid* g, int rank, Stencil* st) noexcept nogil:
 
 # ----------------------------------------------------------------- row sorting
 
+cdef Py_ssize_t _run_end(const int* v, Py_ssize_t i, Py_ssize_t n) noexcept nogil:
+    """End of the ascending run of ``v`` that starts at ``i``."""
+    i += 1
+    while i < n and v[i - 1] <= v[i]:
+        i += 1
+    return i
+
+
+cdef void _merge(const int* a, Py_ssize_t na, const int* b, Py_ssize_t nb,
+                 int* out) noexcept nogil:
+    """Merge the ascending ``a`` and ``b`` into ``out``."""
+    cdef Py_ssize_t i = 0, j = 0, k = 0
+    while i < na and j < nb:
+        if b[j] < a[i]:
+            out[k] = b[j]
+            j += 1
+        else:
+            out[k] = a[i]
+            i += 1
+        k += 1
+    while i < na:
+        out[k] = a[i]
+        i += 1
+        k += 1
+    while j < nb:
+        out[k] = b[j]
+        j += 1
+        k += 1
+
+
 cdef void _insertion_sort(int* v, Py_ssize_t n) noexcept nogil:
+    """O(n + inversions): the fastest for short, nearly sorted rows."""
     cdef Py_ssize_t i, j
     cdef int key
     for i in range(1, n):
@@ -287,46 +322,39 @@ cdef void _insertion_sort(int* v, Py_ssize_t n) noexcept nogil:
         v[j + 1] = key
 
 
-cdef void _sift_down(int* v, Py_ssize_t root, Py_ssize_t end) noexcept nogil:
-    """Restore the max-heap property of ``v[root:end]`` below ``root``."""
-    cdef Py_ssize_t child
-    cdef int tmp
-    while 2 * root + 1 < end:
-        child = 2 * root + 1
-        if child + 1 < end and v[child] < v[child + 1]:
-            child += 1
-        if v[root] >= v[child]:
-            return
-        tmp = v[root]
-        v[root] = v[child]
-        v[child] = tmp
-        root = child
+cdef void _sort_row(int* v, Py_ssize_t n, int* tmp) noexcept nogil:
+    """Sort one row ascending; free if already sorted.
 
+    Rows are concatenations of ascending runs (one per cell), nearly sorted when the
+    arrays were spatially sorted not long ago.  Short rows: insertion sort.  Long
+    rows: a natural merge sort that merges neighbouring runs pass after pass,
+    O(n log(runs)).  ``tmp`` has room for ``n`` entries."""
+    cdef int* src = v
+    cdef int* dst = tmp
+    cdef int* swap
+    cdef Py_ssize_t i, j, k, runs
+    if _run_end(v, 0, n) >= n:
+        return
+    if n <= _SHORT_ROW:
+        _insertion_sort(v, n)
+        return
+    while True:
+        runs = 0
+        i = 0
+        while i < n:
+            j = _run_end(src, i, n)
+            k = _run_end(src, j, n) if j < n else n
+            _merge(src + i, j - i, src + j, k - j, dst + i)
+            runs += 1
+            i = k
+        swap = src
+        src = dst
+        dst = swap
+        if runs == 1:
+            break
+    if src != v:
+        memcpy(v, src, n * sizeof(int))
 
-cdef void _heap_sort(int* v, Py_ssize_t n) noexcept nogil:
-    cdef Py_ssize_t start = n // 2 - 1, end = n - 1
-    cdef int tmp
-    while start >= 0:
-        _sift_down(v, start, n)
-        start -= 1
-    while end > 0:
-        tmp = v[0]
-        v[0] = v[end]
-        v[end] = tmp
-        _sift_down(v, 0, end)
-        end -= 1
-
-
-cdef void _sort_row(int* v, Py_ssize_t n) noexcept nogil:
-    """Sort one row ascending: free if already sorted, O(n log n) worst case."""
-    cdef Py_ssize_t i
-    for i in range(1, n):
-        if v[i] < v[i - 1]:
-            if n <= 32:
-                _insertion_sort(v, n)
-            else:
-                _heap_sort(v, n)
-            return
 
 # ------------------------------------------------------------ scanning cells
 
@@ -390,9 +418,16 @@ cdef Py_ssize_t _scan_cell_pair_image(const Grid* g, const double* xi, const Bin
 
 
 cdef int _reserve(Row* buf, Py_ssize_t extra) noexcept nogil:
-    """Make room for ``extra`` more entries; 0 on success, -1 if out of memory."""
+    """Make room for ``extra`` more entries (and a row of ``extra`` in the sorting
+    scratch); 0 on success, -1 if out of memory."""
     cdef Py_ssize_t cap
     cdef int* data
+    if extra > buf.tmp_cap:
+        data = <int*>realloc(buf.tmp, extra * sizeof(int))
+        if data == NULL:
+            return -1
+        buf.tmp = data
+        buf.tmp_cap = extra
     if buf.used + extra <= buf.cap:
         return 0
     cap = 2 * buf.cap
@@ -462,7 +497,7 @@ cdef int _block_rows(const Grid* g, const Bins* d, const Bins* s, double reach2_
                 else:
                     cnt += _scan_cell(g.dim, xi, s, st.cells[c], st.shift[c], out + cnt)
             if not src_in_cell_order:
-                _sort_row(out, cnt)
+                _sort_row(out, cnt, buf.tmp)
             i = d.index[p]
             counts[i] = <int>cnt
             buf.used += cnt
@@ -633,6 +668,8 @@ def build_csr(GridSpec grid, dest_bins, src_bins, Py_ssize_t block_size=128):
         bufs[b].data = NULL
         bufs[b].used = 0
         bufs[b].cap = 0
+        bufs[b].tmp = NULL
+        bufs[b].tmp_cap = 0
     try:
         for b in prange(nb, nogil=True, schedule="dynamic"):
             failed += _block_rows(g, &d, &s, reach2_s, in_order, bounds[b], bounds[b + 1], pc, &bufs[b]) != 0
@@ -647,6 +684,7 @@ def build_csr(GridSpec grid, dest_bins, src_bins, Py_ssize_t block_size=128):
     finally:
         for b in range(nb):
             free(bufs[b].data)
+            free(bufs[b].tmp)
         free(bufs)
     return offsets_arr, nbrs_arr
 
@@ -657,6 +695,8 @@ def remap_csr(int[::1] offsets, int[::1] nbrs, int[::1] perm_dest, int[::1] inv_
     ``perm_dest[new] = old`` for the destination rows, ``inv_src[old] = new`` for the
     source indices.  Returns the new ``(offsets, nbrs)``, rows ascending."""
     cdef Py_ssize_t nd = perm_dest.shape[0], i, p, o, start, cnt
+    cdef int failed = 0
+    cdef int* tmp
     cdef int[::1] counts = np.empty(nd, dtype=np.int32)
     new_off_arr = np.empty(nd + 1, dtype=np.int32)
     cdef int[::1] new_off = new_off_arr
@@ -676,5 +716,13 @@ def remap_csr(int[::1] offsets, int[::1] nbrs, int[::1] perm_dest, int[::1] inv_
         o = new_off[i]
         for p in range(cnt):
             pn[o + p] = inv_src[nbrs[start + p]]
-        _sort_row(pn + o, cnt)
+        if _run_end(pn + o, 0, cnt) < cnt:
+            tmp = <int*>malloc(cnt * sizeof(int))
+            if tmp == NULL:
+                failed += 1
+            else:
+                _sort_row(pn + o, cnt, tmp)
+                free(tmp)
+    if failed:
+        raise MemoryError("out of memory while remapping a neighbour list")
     return new_off_arr, new_nbrs_arr

@@ -1,0 +1,114 @@
+"""Application, solver and output: info.json, cache, restart, blow-up guard, XDMF."""
+import json
+import os
+
+import numpy as np
+import pytest
+
+from sphgen import io
+from sphgen.app import load_application, main
+from sphgen.solver import BlowUpError
+
+
+def tg(args):
+    app = load_application("taylor_green")()
+    app.run(["--no-progress", "--nx", "16"] + args)
+    return app
+
+
+def test_info_json_outputs_and_xdmf(tmp_path):
+    out = tmp_path / "run"
+    tg(["--tf", "0.02", "--pfreq", "10", "-d", str(out)])
+    info = json.load(open(out / "info.json"))
+    for key in ("completed", "t", "steps", "n_particles", "wall_time", "compile_time", "threads",
+                "options", "time_per_particle_step", "neighbour_pairs_per_step"):
+        assert key in info, key
+    assert info["completed"] is True and info["n_particles"] == 256
+    assert info["t"] == pytest.approx(0.02) and info["options"]["nx"] == 16
+    files = io.output_files(out)
+    assert len(files) == info["steps"] // 10 + 1 + (info["steps"] % 10 > 0)
+    assert (out / "taylor_green.xdmf").exists()
+    last = io.load(files[-1])
+    assert last["solver_data"]["step"] == info["steps"]
+    assert set(last["arrays"]["fluid"].data) >= {"x", "y", "u", "v", "p", "rho"}
+    res = json.load(open(out / "results.json"))
+    assert {"l1_error", "max_u", "max_u_exact"} <= set(res)
+
+
+def test_second_run_compiles_nothing(tmp_path, tmp_cache):
+    tg(["--tf", "0.002", "-d", str(tmp_path / "a"), "--disable-output"])
+    tg(["--tf", "0.002", "-d", str(tmp_path / "b"), "--disable-output"])
+    first = json.load(open(tmp_path / "a" / "info.json"))
+    second = json.load(open(tmp_path / "b" / "info.json"))
+    assert first["compile_time"] > 0.5
+    assert second["compile_time"] == 0.0
+
+
+def test_restart_continues_the_same_run(tmp_path):
+    full = tmp_path / "full"
+    tg(["--tf", "0.03", "--pfreq", "10", "-d", str(full), "--no-openmp"])
+    files = io.output_files(full)
+    mid = [f for f in files if io.load(f)["solver_data"]["step"] == 10][0]
+    part = tmp_path / "part"
+    tg(["--tf", "0.03", "--pfreq", "10", "-d", str(part), "--restart", mid, "--no-openmp"])
+    a = io.load(io.output_files(full)[-1])
+    b = io.load(io.output_files(part)[-1])
+    assert a["solver_data"]["step"] == b["solver_data"]["step"]
+    for p in ("x", "y", "u", "v", "p"):
+        np.testing.assert_allclose(b["arrays"]["fluid"].data[p], a["arrays"]["fluid"].data[p],
+                                   rtol=0, atol=1e-10)
+
+
+def test_blow_up_stops_with_where_and_keeps_last_good_state(tmp_path):
+    out = tmp_path / "boom"
+    with pytest.raises(BlowUpError) as e:
+        tg(["--tf", "100", "--dt", "0.2", "-d", str(out), "--disable-output"])
+    msg = str(e.value)
+    assert "of fluid particle" in msg and "exceeds the scheme's limit 10" in msg
+    assert "step" in msg and "t=" in msg
+    assert "last good state" in msg
+    good = io.load(str(out / "taylor_green_last_good.h5"))
+    for name, arr in good["arrays"]["fluid"].data.items():
+        assert np.all(np.isfinite(arr)), name
+    info = json.load(open(out / "info.json"))
+    assert info["completed"] is False and "exceeds" in info["error"]
+
+
+def test_non_finite_value_stops_at_once_naming_array_property_particle(tmp_path):
+    from sphgen.integrators import IntegratorStep, PEC
+    from sphgen.scene import Scene
+    from sphgen.solver import Solver
+    from conftest import lattice_cloud
+
+    class Poison(IntegratorStep):
+        def stage1(self, d_idx, d_x, d_p, dt):
+            d_x[d_idx] += 0.0
+            if d_idx == 7:
+                d_p[d_idx] = d_p[d_idx] * 1e200   # 0.1, 1e199, inf
+
+        def stage2(self, d_idx, d_x, dt):
+            d_x[d_idx] += 0.0
+
+    pa = lattice_cloud(nx=4)
+    pa.add_property("p", data=np.full(pa.n, 0.1))
+    integ = PEC(fluid=Poison())
+    sc = Scene([pa], [], steppers=integ.steppers, dim=2, outputs={"fluid": ["p"]})
+    solver = Solver(sc, integ, dt=0.1, tf=10.0, outdir=str(tmp_path), prefix="poison", progress=False)
+    with pytest.raises(BlowUpError) as e:
+        solver.run()
+    assert str(e.value).startswith("non-finite fluid.p at particle")
+    good = io.load(str(tmp_path / "poison_last_good.h5"))
+    assert np.all(np.isfinite(good["arrays"]["fluid"].data["p"]))
+    assert good["solver_data"]["step"] == solver.step
+
+
+def test_show_plan_prints_plan_and_exits(tmp_path, capsys):
+    assert main(["run", "taylor_green", "--nx", "16", "--show-plan", "-d", str(tmp_path)]) == 0
+    text = capsys.readouterr().out
+    assert "prune Vorticity2D[fluid<-fluid]" in text and "properties allocated:" in text
+    assert not os.path.exists(tmp_path / "info.json")
+
+
+def test_sphgen_list_names_taylor_green(capsys):
+    assert main(["list"]) == 0
+    assert "taylor_green" in capsys.readouterr().out.split()

@@ -1,0 +1,118 @@
+"""Errors people get: clear, early, naming the equation, array and property."""
+import numpy as np
+import pytest
+
+from sphgen.codegen.build import CompileError
+from sphgen.codegen.plan import SceneError
+from sphgen.equation import Equation, Group, ParameterError
+from sphgen.particles import ParticleArray, PropertyError
+from sphgen.scene import Scene
+from sphgen.equations.basic import SummationDensity
+from sphgen.equations.edac import EDACPressureRate
+
+from conftest import lattice_cloud
+
+
+class Misspelt(Equation):
+    def loop(self, d_idx, d_rhoo, s_idx, s_m, WIJ):
+        d_rhoo[d_idx] += s_m[s_idx] * WIJ
+
+
+def test_misspelt_property_names_equation_array_and_suggestion():
+    pa = lattice_cloud()
+    with pytest.raises(SceneError) as e:
+        Scene([pa], [Misspelt("fluid", ["fluid"], keep=True)], dim=2, outputs={"fluid": ["rho"]})
+    msg = str(e.value)
+    assert "Misspelt[fluid<-fluid]" in msg and "'rhoo'" in msg and "array 'fluid'" in msg
+    assert "did you mean 'rho'?" in msg
+
+
+def test_property_read_but_never_set_is_an_error_before_compiling():
+    pa = ParticleArray("fluid", x=np.zeros(4), h=np.ones(4))
+    with pytest.raises(SceneError, match=r"SummationDensity\[fluid<-fluid\] reads property 'm' of "
+                                         r"array 'fluid', but nothing sets it"):
+        Scene([pa], [SummationDensity("fluid", ["fluid"])], dim=1, outputs={"fluid": ["rho"]})
+
+
+def test_unknown_source_array():
+    pa = lattice_cloud()
+    with pytest.raises(SceneError, match=r"no particle array named 'fluids'; did you mean 'fluid'\?"):
+        Scene([pa], [SummationDensity("fluid", ["fluids"])], dim=2, outputs={"fluid": ["rho"]})
+
+
+def test_wrong_shape_and_non_finite_data():
+    with pytest.raises(PropertyError, match=r"property 'sigma' has stride 9 so it needs 4x9 = 36 values; got 4"):
+        ParticleArray("solid", x=np.zeros(4)).add_property("sigma", stride=9, data=np.zeros(4))
+    with pytest.raises(PropertyError, match=r"property 'u' is not finite at particle 2"):
+        ParticleArray("fluid", x=np.zeros(4), u=np.array([0, 1, np.nan, 2.0]))
+
+
+@pytest.mark.parametrize("kw,match", [
+    (dict(c0=-1.0, nu_edac=0.1), r"EDACPressureRate\(dest='fluid'\): parameter c0=-1.0 must be > 0"),
+    (dict(c0=10.0, nu_edac=float("nan")), r"parameter nu_edac=nan is not finite"),
+    (dict(c0=10.0), r"parameter 'nu_edac' is not set"),
+])
+def test_bad_parameters_are_refused_at_construction(kw, match):
+    with pytest.raises(ParameterError, match=match):
+        EDACPressureRate("fluid", ["fluid"], **kw)
+
+
+class WritesSource(Equation):
+    def loop(self, d_idx, d_rho, s_idx, s_rho, WIJ):
+        s_rho[s_idx] += WIJ
+
+
+def test_pair_loops_must_be_gather_only():
+    pa = lattice_cloud()
+    with pytest.raises(SceneError, match=r"WritesSource\[fluid<-fluid\]\.loop writes s_rho: pair "
+                                         r"loops are gather-only"):
+        Scene([pa], [WritesSource("fluid", ["fluid"])], dim=2, outputs={"fluid": ["rho"]})
+
+
+class ReadsWhatGroupWrites(Equation):
+    def loop(self, d_idx, d_p, s_idx, s_rho, WIJ):
+        d_p[d_idx] += s_rho[s_idx] * WIJ
+
+
+def test_reading_a_property_the_same_group_writes_is_refused():
+    pa = lattice_cloud()
+    pa.add_property("p")
+    g = Group([SummationDensity("fluid", ["fluid"]), ReadsWhatGroupWrites("fluid", ["fluid"])])
+    with pytest.raises(SceneError, match=r"reads s_rho of 'fluid' while this group writes 'rho' of "
+                                         r"'fluid': split them into two Groups"):
+        Scene([pa], [g], dim=2, outputs={"fluid": ["p"]})
+
+
+class BadCode(Equation):
+    def initialize(self, d_idx, d_p):
+        d_p[d_idx] = undefined_function(3.0)  # noqa: F821
+
+
+def test_compile_failure_names_equation_class_and_source_line(tmp_cache):
+    pa = lattice_cloud()
+    pa.add_property("p")
+    with pytest.raises(CompileError) as e:
+        Scene([pa], [BadCode("fluid")], dim=2, outputs={"fluid": ["p"]})
+    import inspect
+    line = inspect.getsourcelines(BadCode.initialize)[1] + 1
+    assert f"BadCode.initialize ({__file__}:{line})" in str(e.value)
+    assert "undefined_function" in str(e.value) or "undeclared name" in str(e.value)
+
+
+def test_unknown_application_option_is_refused(capsys):
+    from sphgen.app import main
+    with pytest.raises(SystemExit):
+        main(["run", "taylor_green", "--nxx", "10"])
+    assert "unrecognized arguments: --nxx 10" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("args,match", [
+    (["--tf", "-1"], "must be a non-negative finite number"),
+    (["--dt", "nan"], "must be a positive finite number"),
+    (["--re", "inf"], "--re must be a positive finite number"),
+])
+def test_bad_option_values(args, match, capsys):
+    from sphgen.app import main
+    with pytest.raises(SystemExit) as e:
+        main(["run", "taylor_green", "--disable-output"] + args)
+    assert match in (capsys.readouterr().err + str(e.value.code))
