@@ -28,10 +28,6 @@ _AXES = ("x", "y", "z")
 # Cells are a little larger than the cut-off so that floating-point rounding in the
 # cell coordinates can never put two neighbours two cells apart.
 _CELL_MARGIN = 1.0 + 1e-9
-# Cells per cut-off, by dimension: edges of cut-off/m and a (2m+1)**dim stencil.
-# Smaller cells scan fewer far candidates but visit more cells (see sort of timings
-# in the tests' docstring); m = 2 pays off in 3D only.
-SUBDIVISION = {1: 1, 2: 1, 3: 2}
 
 
 class NotFrozenError(KeyError):
@@ -150,7 +146,6 @@ class NeighbourSearch:
         self.radius_scale = radius_scale
         self.domain = domain
         self.n_updates = 0
-        self.subdivision = SUBDIVISION[self.dim]
         self._by_name = dict(zip(names, arrays))
         self._cache = {}
         self._frozen = {}
@@ -227,8 +222,7 @@ class NeighbourSearch:
                     f"periodic {_AXES[a]}-length {dom.length[a]} is less than twice the "
                     f"largest cut-off radius_scale*max(h) = {cutoff}: the minimum image is "
                     "not unique (enlarge the box or reduce h)")
-        m = self.subdivision
-        self._make_grid(lo, hi, cutoff * _CELL_MARGIN / m, ntotal, m)
+        self._make_grid(lo, hi, cutoff * _CELL_MARGIN, ntotal)
         self._bins = {}
         self._sizes = {}
         for pa in self.arrays:
@@ -251,7 +245,7 @@ class NeighbourSearch:
         raise ValueError(f"array '{pa.name}': particle {i} has a non-finite {prop} "
                          f"({pa.get(prop)[i]}); the neighbour search needs finite values")
 
-    def _make_grid(self, lo, hi, cell, ntotal, m):
+    def _make_grid(self, lo, hi, cell, ntotal):
         """Choose the grid: cells of edge ``>= cell`` (periodic axes: L/n exactly),
         anchored at multiples of the edge on open axes; coarsened if the cells would
         far outnumber the particles (a few particles far away)."""
@@ -275,7 +269,7 @@ class NeighbourSearch:
             self._rank = _morton_rank(g_n, dim)
             self._rank_key = key
         self.grid = GridSpec(dim, g_lo, g_cs, g_len, g_n,
-                             [int(p) for p in dom.periodic], self._rank, m)
+                             [int(p) for p in dom.periodic], self._rank)
         self.cell_size = tuple(g_cs)
         self.n_cells = tuple(g_n)
 

@@ -56,9 +56,8 @@ ctypedef struct Grid:
     double half[3]       # length / 2
     int n[3]             # cells along each axis (1 for unused axes)
     int periodic[3]      # 1 if the axis is periodic
-    int all_cells[3]     # periodic axis with < 2m+1 cells: visit every cell, pair image
+    int all_cells[3]     # periodic axis with < 3 cells: visit every cell, pair image
     int any_all_cells    # some axis has all_cells
-    int m                # cells per cut-off: neighbours are within m cells
     const int* rank      # linear cell index -> storage rank
     const int* unrank    # storage rank -> linear cell index
 
@@ -71,16 +70,15 @@ ctypedef struct Bins:
 
 
 cdef enum:
-    MAX_M = 2                           # largest subdivision m
-    MAX_AXIS = 2 * MAX_M + 1            # stencil width per axis
-    MAX_CELLS = MAX_AXIS * MAX_AXIS * MAX_AXIS
+    MAX_CELLS = 27       # a cell and its neighbours
 
 
 ctypedef struct Stencil:
     int nc                       # number of neighbour cells
     int cells[MAX_CELLS]         # their ranks, ascending
     double shift[MAX_CELLS][3]   # image shift added to x_i - x_j for each cell
-    int off[MAX_CELLS][3]        # offset from the centre cell, m + (-m..m); m if unprunable
+    int side[MAX_CELLS][3]       # 0: the cell is below on that axis, 2: above,
+                                 # 1: same (or cannot prune)
     double corner[3]             # lower corner of the centre cell
 
 
@@ -98,23 +96,19 @@ cdef class GridSpec:
     ``lo``, ``cs`` (cell edges), ``length`` (periodic box lengths), ``n`` (cells) and
     ``periodic`` are length-3 sequences (unused axes: ``n = 1``); ``rank`` is an
     int32 array of ``prod(n)`` entries, the storage rank of each linear cell index.
-    ``m``: the cell edges are at least cut-off / m, so neighbours are at most ``m``
-    cells apart (1 or 2).
+    Cell edges are at least the largest cut-off: neighbours are in adjacent cells.
     """
     cdef Grid c
     cdef int[::1] _rank
     cdef int[::1] _unrank
     cdef readonly Py_ssize_t ncells
 
-    def __init__(self, int dim, lo, cs, length, n, periodic, int[::1] rank, int m=1):
+    def __init__(self, int dim, lo, cs, length, n, periodic, int[::1] rank):
         cdef int a
         cdef Py_ssize_t i
         if dim < 1 or dim > 3:
             raise ValueError(f"dim must be 1, 2 or 3, got {dim}")
-        if m < 1 or m > MAX_M:
-            raise ValueError(f"m must be 1..{MAX_M}, got {m}")
         self.c.dim = dim
-        self.c.m = m
         self.c.any_all_cells = 0
         self.ncells = 1
         for a in range(3):
@@ -127,7 +121,7 @@ cdef class GridSpec:
             self.c.half[a] = 0.5 * length[a]
             self.c.n[a] = n[a]
             self.c.periodic[a] = 1 if (periodic[a] and a < dim) else 0
-            self.c.all_cells[a] = 1 if (self.c.periodic[a] and n[a] < 2 * m + 1) else 0
+            self.c.all_cells[a] = 1 if (self.c.periodic[a] and n[a] < 3) else 0
             self.c.any_all_cells |= self.c.all_cells[a]
             self.ncells *= n[a]
         if rank.shape[0] != self.ncells:
@@ -190,25 +184,24 @@ cdef inline double _min_image(const Grid* g, int a, double d) noexcept nogil:
 
 
 cdef int _axis_candidates(const Grid* g, int a, int c, int* out, double* shift,
-                          int* off) noexcept nogil:
+                          int* side) noexcept nogil:
     """Distinct cell coordinates along axis ``a`` that may hold neighbours of cell
-    ``c``; for each, the image shift to add to ``x_i - x_j`` and the offset
-    ``m + (q - c)`` (``m``, i.e. zero distance, where it cannot prune).  Returns the
-    count (at most ``2m + 1``)."""
+    ``c``; for each, the image shift to add to ``x_i - x_j`` and the side (0 below,
+    2 above, 1 same or cannot prune).  Returns the count (at most 3)."""
     cdef int nout = 0, k, q
     cdef double s
     if a >= g.dim:
         out[0] = 0
         shift[0] = 0.0
-        off[0] = g.m
+        side[0] = 1
         return 1
     if g.all_cells[a]:          # pair-by-pair minimum image instead of a shift
         for k in range(g.n[a]):
             out[k] = k
             shift[k] = 0.0
-            off[k] = g.m
+            side[k] = 1
         return g.n[a]
-    for k in range(-g.m, g.m + 1):
+    for k in range(-1, 2):
         q = c + k
         s = 0.0
         if q < 0:
@@ -223,7 +216,7 @@ cdef int _axis_candidates(const Grid* g, int a, int c, int* out, double* shift,
             s = -g.length[a]    # ... at x + L
         out[nout] = q
         shift[nout] = s
-        off[nout] = k + g.m
+        side[nout] = k + 1
         nout += 1
     return nout
 
@@ -238,17 +231,17 @@ cdef void _swap_cells(Stencil* st, int p, int q) noexcept nogil:
         td = st.shift[p][a]
         st.shift[p][a] = st.shift[q][a]
         st.shift[q][a] = td
-        ti = st.off[p][a]
-        st.off[p][a] = st.off[q][a]
-        st.off[q][a] = ti
+        ti = st.side[p][a]
+        st.side[p][a] = st.side[q][a]
+        st.side[q][a] = ti
 
 
 cdef void _stencil(const Grid* g, int rank, Stencil* st) noexcept nogil:
-    """The (at most (2m+1)**3, distinct) cells around the cell of rank ``rank``,
-    sorted by rank, with their image shifts and offsets; and the cell's corner."""
-    cdef int cand[3][MAX_AXIS]
-    cdef double sh[3][MAX_AXIS]
-    cdef int sd[3][MAX_AXIS]
+    """The (at most 27, distinct) cells around the cell of rank ``rank``, sorted by
+    rank, with their image shifts and sides; and the cell's lower corner."""
+    cdef int cand[3][3]
+    cdef double sh[3][3]
+    cdef int sd[3][3]
     cdef int m[3]
     cdef int c[3]
     cdef int a, p, q, r, lin = g.unrank[rank]
@@ -266,11 +259,11 @@ cdef void _stencil(const Grid* g, int rank, Stencil* st) noexcept nogil:
                 st.shift[st.nc][0] = sh[0][p]
                 st.shift[st.nc][1] = sh[1][q]
                 st.shift[st.nc][2] = sh[2][r]
-                st.off[st.nc][0] = sd[0][p]
-                st.off[st.nc][1] = sd[1][q]
-                st.off[st.nc][2] = sd[2][r]
+                st.side[st.nc][0] = sd[0][p]
+                st.side[st.nc][1] = sd[1][q]
+                st.side[st.nc][2] = sd[2][r]
                 st.nc += 1
-    for p in range(1, st.nc):       # insertion sort by rank (<= 125 cells)
+    for p in range(1, st.nc):       # insertion sort by rank (<= 27 cells)
         q = p
         while q > 0 and st.cells[q - 1] > st.cells[q]:
             _swap_cells(st, q - 1, q)
@@ -292,7 +285,7 @@ cdef void _merge(const int* a, Py_ssize_t na, const int* b, Py_ssize_t nb,
     """Merge the ascending ``a`` and ``b`` into ``out``."""
     cdef Py_ssize_t i = 0, j = 0, k = 0
     while i < na and j < nb:
-        if b[j] < a[i]:
+        if b[j] > a[i]:
             out[k] = b[j]
             j += 1
         else:
@@ -442,20 +435,17 @@ cdef int _reserve(Row* buf, Py_ssize_t extra) noexcept nogil:
 
 
 cdef void _gaps(const Grid* g, const Stencil* st, const double* xi,
-               double gap2[3][MAX_AXIS]) noexcept nogil:
-    """``gap2[a][m + k]``: squared distance along axis ``a`` from ``xi`` to the cells
-    ``k`` cells away from the centre cell (0 for ``k = 0``)."""
-    cdef int a, k
-    cdef double below, above, gap
+               double gap2[3][3]) noexcept nogil:
+    """``gap2[a][side]``: squared distance along axis ``a`` from ``xi`` to the cells
+    below (side 0), level with (1: zero) and above (2) the centre cell."""
+    cdef int a
+    cdef double below, above
     for a in range(3):
         below = xi[a] - st.corner[a]
         above = st.corner[a] + g.cs[a] - xi[a]
-        gap2[a][g.m] = 0.0
-        for k in range(1, g.m + 1):
-            gap = below + (k - 1) * g.cs[a]
-            gap2[a][g.m - k] = gap * gap if gap > 0.0 else 0.0
-            gap = above + (k - 1) * g.cs[a]
-            gap2[a][g.m + k] = gap * gap if gap > 0.0 else 0.0
+        gap2[a][0] = below * below if below > 0.0 else 0.0
+        gap2[a][1] = 0.0
+        gap2[a][2] = above * above if above > 0.0 else 0.0
 
 
 cdef int _block_rows(const Grid* g, const Bins* d, const Bins* s, double reach2_s,
@@ -467,7 +457,7 @@ cdef int _block_rows(const Grid* g, const Bins* d, const Bins* s, double reach2_
     rows come out ascending (cells are visited by rank).  Returns 0, or -1 if out
     of memory."""
     cdef Stencil st
-    cdef double gap2[3][MAX_AXIS]
+    cdef double gap2[3][3]
     cdef int c, r, i
     cdef Py_ssize_t p, upper, cnt
     cdef const double* xi
@@ -489,8 +479,8 @@ cdef int _block_rows(const Grid* g, const Bins* d, const Bins* s, double reach2_
             out = buf.data + buf.used
             cnt = 0
             for c in range(st.nc):
-                if (gap2[0][st.off[c][0]] + gap2[1][st.off[c][1]]
-                        + gap2[2][st.off[c][2]]) >= reach2:
+                if (gap2[0][st.side[c][0]] + gap2[1][st.side[c][1]]
+                        + gap2[2][st.side[c][2]]) >= reach2:
                     continue        # every point of the cell is out of reach
                 if g.any_all_cells:
                     cnt += _scan_cell_pair_image(g, xi, s, st.cells[c], st.shift[c], out + cnt)

@@ -1,0 +1,15 @@
+#!/usr/bin/env python
+"""Regenerate every figure: ``python automate.py`` (automan; see ``--help``).
+
+Simulations go to ``outputs/``, figures to ``manuscript/figures/``.  Finished cases
+(``info.json`` with ``completed: true``) are not run again.
+"""
+from automan.api import Automator
+
+from automation.taylor_green import TaylorGreenEDAC
+
+PROBLEMS = [TaylorGreenEDAC]
+
+if __name__ == "__main__":
+    Automator(simulation_dir="outputs", output_dir="manuscript/figures",
+              all_problems=PROBLEMS).run()

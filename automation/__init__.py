@@ -1,0 +1,1 @@
+"""automan problems, one module per paper or case family."""
