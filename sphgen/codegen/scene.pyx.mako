@@ -89,8 +89,10 @@ def pass_${p.name}(double t, double dt):
 % for s in stages:
 def stage_${s.name}(double t, double dt):
     cdef long d_idx
+    # a stage is a few flops per particle: threads only pay off for large arrays
+    cdef int nt = _nthreads if ${s.array}_n > 20000 else 1
     with nogil:
-        for d_idx in prange(${s.array}_n, num_threads=_nthreads, schedule='static'):
+        for d_idx in prange(${s.array}_n, num_threads=nt, schedule='static'):
             ${s.call}
 
 % endfor

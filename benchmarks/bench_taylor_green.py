@@ -1,0 +1,122 @@
+#!/usr/bin/env python
+"""Taylor-Green (EDAC, nx=50, Re=100, tf=0.5): sphgen against PySPH in the same run.
+
+Prints, as medians of ``--repeat`` runs: time per particle-step (serial and 2 threads),
+neighbour pairs per second, the 1 -> 2 thread speed-up, the first-run compile time, and
+the ratio against PySPH 1.0b2 (``pysph run taylor_green --scheme edac``) when a PySPH
+venv is found (``PYSPH_PYTHON``; see ``pysph_baseline.find_pysph_python``).  The
+machine may be shared: each row also reports the CPU seconds other processes used
+during the runs (0 means a clean timing).
+
+    python benchmarks/bench_taylor_green.py [--nx 50] [--tf 0.5] [--repeat 3]
+"""
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from pysph_baseline import _busy_cpu_seconds, find_pysph_python, run_pysph  # noqa: E402
+
+
+def run_sphgen(nx, tf, threads, workdir, cache=None):
+    """One sphgen run as a subprocess; returns its info.json plus contention."""
+    out = os.path.join(workdir, f"sphgen_nx{nx}_t{threads}_{time.time_ns()}")
+    exe = os.path.join(os.path.dirname(sys.executable), "sphgen")
+    cmd = [exe, "run", "taylor_green", "--nx", str(nx), "--tf", str(tf), "--disable-output",
+           "--no-progress", "-d", out]
+    cmd += ["--no-openmp"] if threads == 1 else ["--threads", str(threads)]
+    env = dict(os.environ)
+    if cache:
+        env["SPHGEN_CACHE"] = cache
+    busy0, t0 = _busy_cpu_seconds(), time.perf_counter()
+    r0 = os.times()
+    subprocess.run(cmd, check=True, env=env, stdout=subprocess.DEVNULL)
+    r1 = os.times()
+    wall = time.perf_counter() - t0
+    busy1 = _busy_cpu_seconds()
+    with open(os.path.join(out, "info.json")) as f:
+        info = json.load(f)
+    own = (r1.children_user - r0.children_user) + (r1.children_system - r0.children_system)
+    info["other_cpu_s"] = (busy1 - busy0 - own) if busy0 is not None else None
+    info["process_wall_s"] = wall
+    return info
+
+
+def summarise_sphgen(runs):
+    n = runs[0]["n_particles"]
+    steps = runs[0]["steps"]
+    pairs = runs[0]["neighbour_pairs_per_step"]
+    walls = [r["wall_time"] for r in runs]
+    med = statistics.median(walls)
+    return {"wall_s": med, "us_per_particle_step": 1e6 * med / (n * steps),
+            "pairs_per_s": pairs * steps / med, "steps": steps, "n": n,
+            "other_cpu_s": [round(r["other_cpu_s"] or 0, 2) for r in runs], "walls": walls}
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--nx", type=int, default=50)
+    p.add_argument("--tf", type=float, default=0.5)
+    p.add_argument("--repeat", type=int, default=3)
+    p.add_argument("--no-pysph", action="store_true")
+    p.add_argument("--json", default=None, help="write the results here")
+    o = p.parse_args(argv)
+    work = tempfile.mkdtemp(prefix="sphgen_bench_")
+    res = {"nx": o.nx, "tf": o.tf, "repeat": o.repeat, "load_start": os.getloadavg()[0]}
+
+    cold = run_sphgen(o.nx, o.tf, 2, work, cache=os.path.join(work, "cache"))
+    res["sphgen_compile_s"] = cold["compile_time"]
+    for threads in (1, 2):
+        runs = [run_sphgen(o.nx, o.tf, threads, work) for _ in range(o.repeat)]
+        res[f"sphgen_{threads}"] = summarise_sphgen(runs)
+    s1, s2 = res["sphgen_1"], res["sphgen_2"]
+    res["sphgen_speedup_1_to_2"] = s1["wall_s"] / s2["wall_s"]
+
+    py = None if o.no_pysph else find_pysph_python()
+    if py:
+        for key, omp, thr in (("pysph_1", False, None), ("pysph_2", True, 2)):
+            runs = [run_pysph(py, nx=o.nx, tf=o.tf, openmp=omp, threads=thr,
+                              workdir=os.path.join(work, key)) for _ in range(o.repeat)]
+            ok = [r for r in runs if r["returncode"] == 0 and r.get("us_per_real_particle_step")]
+            if not ok:
+                res[key] = {"error": runs[0].get("stdout_tail", "")[-500:]}
+                continue
+            res[key] = {"run_s": statistics.median(r["run_s"] for r in ok),
+                        "us_per_particle_step": statistics.median(r["us_per_real_particle_step"] for r in ok),
+                        "steps": ok[0]["steps"], "n_real": ok[0]["n_real"], "n_array": ok[0]["n_array"],
+                        "other_cpu_s": [round(r["other_cpu_s"] or 0, 2) for r in ok]}
+        for t in (1, 2):
+            if "us_per_particle_step" in res.get(f"pysph_{t}", {}):
+                res[f"ratio_{t}"] = res[f"pysph_{t}"]["us_per_particle_step"] / res[f"sphgen_{t}"]["us_per_particle_step"]
+    res["load_end"] = os.getloadavg()[0]
+
+    print(f"Taylor-Green EDAC nx={o.nx} ({o.nx * o.nx} particles), tf={o.tf}, medians of {o.repeat}")
+    print(f"{'':24s}{'us/particle-step':>18s}{'pairs/s':>12s}{'wall s':>9s}  other-CPU s")
+    for t in (1, 2):
+        s = res[f"sphgen_{t}"]
+        print(f"sphgen {t} thread(s){'':6s}{s['us_per_particle_step']:18.3f}{s['pairs_per_s']:12.3g}"
+              f"{s['wall_s']:9.2f}  {s['other_cpu_s']}")
+    for t in (1, 2):
+        s = res.get(f"pysph_{t}")
+        if s and "us_per_particle_step" in s:
+            print(f"PySPH  {t} thread(s){'':6s}{s['us_per_particle_step']:18.3f}{'':12s}{s['run_s']:9.2f}"
+                  f"  {s['other_cpu_s']}")
+    print(f"sphgen speed-up 1 -> 2 threads: {res['sphgen_speedup_1_to_2']:.2f}x")
+    for t in (1, 2):
+        if f"ratio_{t}" in res:
+            print(f"PySPH / sphgen time per particle-step, {t} thread(s): {res[f'ratio_{t}']:.2f}x")
+    print(f"sphgen first-run compile time: {res['sphgen_compile_s']:.2f} s")
+    print(f"load average: {res['load_start']:.2f} at start, {res['load_end']:.2f} at end")
+    if o.json:
+        with open(o.json, "w") as f:
+            json.dump(res, f, indent=1)
+    return res
+
+
+if __name__ == "__main__":
+    main()
