@@ -6,7 +6,6 @@ Application and runs it; ``sphgen list`` names the applications.  Every run writ
 """
 import argparse
 import importlib
-import json
 import math
 import os
 import pkgutil

@@ -132,14 +132,12 @@ class ParticleArray:
     def has(self, name):
         return name in self.props or name in self.constants
 
-    def missing_message(self, name, who=""):
+    def missing_message(self, name):
+        """'array X has no property Y; did you mean Z? (known: ...)'."""
         known = sorted(set(self.props) | set(self.constants))
         close = difflib.get_close_matches(name, known, n=1)
         hint = f"; did you mean '{close[0]}'?" if close else ""
-        who = f"{who} needs " if who else ""
-        return (f"array '{self.name}' has no property '{name}'{hint} ({who}known: "
-                f"{', '.join(known)})") if not who else (
-                f"{who}property '{name}' of array '{self.name}', which has no such property{hint}")
+        return f"array '{self.name}' has no property '{name}'{hint} (known: {', '.join(known)})"
 
     def permute(self, perm):
         """Reorder the particles in place (spatial sorting); pointers stay valid."""

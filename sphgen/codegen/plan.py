@@ -279,14 +279,12 @@ class Plan:
                 writers |= ep.writes()
         for st in self.steppers:
             writers |= {(st.array, a[2:]) for sp in st.stages.values() for a in sp.writes if a.startswith("d_")}
-        users = [(ep.name, ep.touched(), ep.reads()) for ep in self.eqplans if ep.kept]
+        users = [(ep.name, ep.reads()) for ep in self.eqplans if ep.kept]
         for st in self.steppers:
-            t = {(st.array, a[2:]) for sp in st.stages.values() for a in sp.args
-                 if a.startswith("d_") and a != "d_idx"}
             r = {(st.array, a[2:]) for sp in st.stages.values() for a in sp.reads
                  if a.startswith("d_") and a != "d_idx"}
-            users.append((f"{type(st.stepper).__name__}[{st.array}]", t, r))
-        for who, touched, reads in users:
+            users.append((f"{type(st.stepper).__name__}[{st.array}]", r))
+        for who, reads in users:
             for arr, prop in sorted(reads):
                 pa = self.arrays[arr]
                 if prop in pa.data or prop in pa.constants or (arr, prop) in writers:

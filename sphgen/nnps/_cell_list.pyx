@@ -285,7 +285,7 @@ cdef void _merge(const int* a, Py_ssize_t na, const int* b, Py_ssize_t nb,
     """Merge the ascending ``a`` and ``b`` into ``out``."""
     cdef Py_ssize_t i = 0, j = 0, k = 0
     while i < na and j < nb:
-        if b[j] > a[i]:
+        if b[j] < a[i]:
             out[k] = b[j]
             j += 1
         else:
