@@ -26,7 +26,9 @@ Cells are stored in *rank* order: the linear grid index ``ix + nx*(iy + ny*iz)``
 mapped through ``rank`` (a Morton/Z-order ranking chosen in Python), so particles
 binned by rank are in a cache-friendly order and a spatial sort is the
 ``cell_index`` permutation.  Neighbour cells are visited in ascending rank, so rows of
-a sorted source come out ascending; otherwise each row is sorted.
+a sorted source come out ascending; otherwise each row is sorted (insertion sort for
+short rows, merging of the per-cell runs for long ones).  Each particle skips the
+neighbour cells whose box lies out of its reach (mostly corner cells).
 
 Periodic axes with at least 3 cells use one image shift per neighbour cell (the
 minimum image, computed as ``(x_i - x_j) -/+ L`` like the usual formula); an axis
@@ -222,6 +224,7 @@ cdef int _axis_candidates(const Grid* g, int a, int c, int* out, double* shift,
 
 
 cdef void _swap_cells(Stencil* st, int p, int q) noexcept nogil:
+    """Swap entries ``p`` and ``q`` of the stencil (rank, shift, side)."""
     cdef int a, ti
     cdef double td
     ti = st.cells[p]
