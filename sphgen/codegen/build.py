@@ -66,7 +66,8 @@ def openmp_flags():
     return _OMP
 
 
-CFLAGS = ["-O3", "-march=native", "-fno-math-errno", "-Wno-unused-function",
+CFLAGS = ["-O3", "-march=native", "-fno-math-errno", "-fno-trapping-math", "-ffp-contract=fast",
+          "-Wno-unused-function",
           "-Wno-unreachable-code", "-Wno-maybe-uninitialized"]
 
 

@@ -5,6 +5,7 @@ from libc.math cimport *
 cimport numpy as cnp
 import numpy as np
 from cython.parallel cimport prange
+cimport openmp
 cnp.import_array()
 
 cdef int _nthreads = 1
@@ -162,5 +163,7 @@ def set_parameters(dict p):
 
 
 def set_threads(int n):
+    """Threads of this module's loops; also the OpenMP default, which the neighbour search uses."""
     global _nthreads
     _nthreads = max(1, n)
+    openmp.omp_set_num_threads(_nthreads)
