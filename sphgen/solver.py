@@ -32,6 +32,10 @@ class Solver:
         self.scene = scene
         self.integrator = integrator
         integrator.attach(scene)
+        if adaptive and not any(p in pa.data for pa in scene.arrays for p in dt_props):
+            raise ValueError(f"adaptive time step reads {', '.join(dt_props)}, which no array of the "
+                             "scene computes: add an equation that writes it and list it in the "
+                             "scene's outputs so the generator keeps it")
         self.dt = float(dt)
         self.tf = float(tf)
         self.adaptive = adaptive

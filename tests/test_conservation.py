@@ -30,3 +30,44 @@ def test_linear_momentum_is_conserved_in_a_periodic_run(pst, alpha):
     assert solver.step == 50
     assert np.abs(p1 - p0).max() / scale < 1e-12
     assert np.abs(pa.au).max() > 1.0  # forces were not trivially zero
+
+
+def test_adaptive_time_step_follows_the_limits_equations_write():
+    from sphgen.equation import Group
+    from sphgen.equations.timestep import TimeStepLimits
+    pa = lattice_cloud(nx=12, jitter=0.2, seed=2)
+    pa.add_property("p", data=np.zeros(pa.n))
+    pa.add_property("w", data=np.zeros(pa.n))
+    pa.add_property("dt_cfl")
+    dx = 1 / 12
+    s = EDACScheme(["fluid"], dim=2, rho0=1.0, c0=10.0, nu=0.05, h=dx, dx=dx, pst="none")
+    s.setup_properties([pa])
+    eqs = s.get_equations()
+    eqs[1].append(Group([TimeStepLimits("fluid", c0=10.0, nu=0.05)]))
+    integ = s.get_integrator()
+    sc = Scene([pa], eqs, steppers=integ.steppers, kernel=s.kernel, dim=2, domain=periodic_box(2),
+               outputs={"fluid": list(s.output_props) + ["dt_cfl"]})
+    # the equation writes the three limits of seed 002 eq. 61 per particle
+    sc.compute(1, 0.0, 1e-3)
+    speed, acc = np.hypot(pa.u, pa.v), np.hypot(pa.au, pa.av)
+    lim = np.minimum(dx / (10.0 + speed), dx * dx / 0.05)
+    lim = np.minimum(lim, np.sqrt(dx / np.where(acc > 0, acc, np.inf)))
+    np.testing.assert_allclose(pa.dt_cfl, lim, rtol=1e-12)
+    seen, expected = [], []
+    solver = Solver(sc, integ, dt=1.0, tf=0.05, adaptive=True, dt_props=("dt_cfl",), cfl=0.25,
+                    progress=False)
+    solver.post_step_callbacks.append(lambda s: seen.append(s.last_dt))
+    orig = integ.one_timestep
+
+    def step(t, dt):
+        expected.append(min(0.25 * pa.dt_cfl.min(), 0.05 - t))
+        orig(t, dt)
+    integ.one_timestep = step
+    solver.run()
+    assert solver.t == pytest.approx(0.05)
+    assert len(seen) == len(expected) > 5
+    np.testing.assert_allclose(seen, expected, rtol=1e-12)
+    assert max(seen) < 0.25 * dx / 10.0 + 1e-15   # the CFL limit binds: dt << the 1.0 asked for
+    pruned = Scene([lattice_cloud(nx=4)], [], dim=2)
+    with pytest.raises(ValueError, match="adaptive time step reads dt_cfl, which no array"):
+        Solver(pruned, integ.__class__(), dt=1.0, tf=1.0, adaptive=True)
