@@ -12,6 +12,8 @@ class Kernel:
 
     radius_scale = 2.0
     name = "kernel"
+    # translated into the scene module in this order (a method may call earlier ones)
+    methods = ("w", "dwdr", "gradh")
 
     def __init__(self, dim):
         if dim not in (1, 2, 3):
@@ -31,20 +33,25 @@ class QuinticSpline(Kernel):
 
     radius_scale = 3.0
     name = "quintic"
+    methods = ("sigma", "w", "dwdr", "gradh")
 
     def __init__(self, dim):
         super().__init__(dim)
         self.fac = {1: 1.0 / 120.0, 2: 7.0 / (478.0 * pi), 3: 1.0 / (120.0 * pi)}[dim]
 
-    def w(self, rij=1.0, h=1.0):
-        """W(r, h) = sigma/h^d [(3-q)^5 - 6(2-q)^5 + 15(1-q)^5] on the pieces of q = r/h."""
+    def sigma(self, h=1.0):
+        """Normalisation sigma / h^dim."""
         hi = 1.0 / h
-        q = rij * hi
         s = self.fac * hi
         if self.dim > 1:
             s = s * hi
         if self.dim > 2:
             s = s * hi
+        return s
+
+    def w(self, rij=1.0, h=1.0):
+        """W(r, h) = sigma/h^d [(3-q)^5 - 6(2-q)^5 + 15(1-q)^5] on the pieces of q = r/h."""
+        q = rij / h
         t3 = 3.0 - q
         t2 = 2.0 - q
         t1 = 1.0 - q
@@ -55,28 +62,22 @@ class QuinticSpline(Kernel):
             val = t3 * t3 * t3 * t3 * t3 - 6.0 * t2 * t2 * t2 * t2 * t2
         elif q < 3.0:
             val = t3 * t3 * t3 * t3 * t3
-        return s * val
+        return self.sigma(h) * val
 
     def dwdr(self, rij=1.0, h=1.0):
-        """dW/dr of the quintic spline."""
-        hi = 1.0 / h
-        q = rij * hi
-        s = self.fac * hi * hi
-        if self.dim > 1:
-            s = s * hi
-        if self.dim > 2:
-            s = s * hi
-        t3 = 3.0 - q
-        t2 = 2.0 - q
-        t1 = 1.0 - q
+        """dW/dr = -5 sigma/h^(d+1) [(3-q)^4 - 6(2-q)^4 + 15(1-q)^4] on the same pieces."""
+        q = rij / h
+        a = 3.0 - q
+        b = 2.0 - q
+        c = 1.0 - q
         val = 0.0
         if q < 1.0:
-            val = -5.0 * (t3 * t3 * t3 * t3 - 6.0 * t2 * t2 * t2 * t2 + 15.0 * t1 * t1 * t1 * t1)
+            val = a * a * a * a - 6.0 * b * b * b * b + 15.0 * c * c * c * c
         elif q < 2.0:
-            val = -5.0 * (t3 * t3 * t3 * t3 - 6.0 * t2 * t2 * t2 * t2)
+            val = a * a * a * a - 6.0 * b * b * b * b
         elif q < 3.0:
-            val = -5.0 * t3 * t3 * t3 * t3
-        return s * val
+            val = a * a * a * a
+        return -5.0 * self.sigma(h) * val / h
 
     def gradh(self, rij=1.0, h=1.0):
         """h dW/dh = -(d W + r dW/dr)."""

@@ -22,8 +22,8 @@ def _ctype(dtype):
     return "double" if dtype == "double" else "int"
 
 
-def pair_symbol_code(syms, dest, src, dim, domain, reference):
-    """Lines computing the requested pair symbols (with their dependencies)."""
+def pair_symbols_needed(syms):
+    """The requested pair symbols and everything they are computed from."""
     need = set(syms)
     if need & {"DWIJ"}:
         need |= {"WDASHIJ", "RIJ", "XIJ"}
@@ -35,6 +35,12 @@ def pair_symbol_code(syms, dest, src, dim, domain, reference):
         need.add("R2IJ")
     if "R2IJ" in need:
         need.add("XIJ")
+    return need
+
+
+def pair_symbol_code(syms, dest, src, dim, domain, reference):
+    """Lines computing the requested pair symbols (with their dependencies)."""
+    need = pair_symbols_needed(syms)
     pos = ("x0", "y0", "z0") if reference else ("x", "y", "z")
     lines = []
     if "XIJ" in need:
@@ -120,7 +126,7 @@ def render(plan):
     """(source, param_values, line_origins) of the scene module."""
     kernel = plan.kernel
     kernel_code = [to_cython(specialise(kernel, m, kernel.constants(), "kernel", keep_defaults=True),
-                             helper=True) for m in ("w", "dwdr", "gradh")]
+                             helper=True) for m in kernel.methods]
     method_code, params, helpers, seen, emitted = [], {}, [], set(), set()
 
     def emit(owner, sp, dtypes):
@@ -169,7 +175,8 @@ def render(plan):
                     alls = [_call(ep.methods["loop_all"], dest, src, key) for ep in lps if "loop_all" in ep.methods]
                     symbols = pair_symbol_code(syms, dest, src, plan.dim, plan.domain, gp.group.reference) \
                         if calls else []
-                    syms_all |= {ln.split(" = ")[0].split("[")[0] for ln in symbols if " = " in ln}
+                    if calls:
+                        syms_all |= pair_symbols_needed(syms)
                     p.sources.append(_Obj(name=src, key=key, symbols=symbols, calls=calls, loop_all=alls))
                 decls = ["cdef long s_idx = 0", "cdef long _k = 0", "cdef double _f = 0.0"]
                 for s in ("XIJ", "VIJ", "DWIJ"):
