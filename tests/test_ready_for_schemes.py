@@ -204,3 +204,20 @@ def test_min_max_reductions_between_groups():
     sc.compute(0, 0.0, 0.1)
     assert pa.rhon.min() == 0.0 and pa.rhon.max() == 1.0
     assert pa.rhomax[0] == pa.rho.max() and pa.rhomin[0] < pa.rhomax[0]
+
+
+class Nudge(Equation):
+    def initialize(self, d_idx, d_x, dt):
+        d_x[d_idx] += dt
+
+
+def test_group_condition_and_update_nnps():
+    pa = lattice_cloud(nx=6)
+    g = Group([Nudge("fluid")], condition=lambda t, dt: t >= 1.0, update_nnps=True)
+    sc = Scene([pa], [g], dim=2, domain=periodic_box(2), outputs={"fluid": ["x"]})
+    x0, n0 = pa.x.copy(), sc.nnps.n_updates
+    sc.compute(0, 0.5, 0.01)                      # condition false: skipped
+    assert np.array_equal(pa.x, x0) and g.iterations == 0 and sc.nnps.n_updates == n0
+    sc.compute(0, 1.0, 0.01)                      # runs, then rebuilds the neighbour lists
+    assert np.allclose((pa.x - x0) % 1.0, 0.01) and g.iterations == 1
+    assert sc.nnps.n_updates == n0 + 1
