@@ -102,13 +102,16 @@ class NeighbourSearch:
 
     Parameters
     ----------
-    arrays : list of ParticleArray (distinct names); each needs ``x`` (``y``, ``z``
-        up to ``dim``) and ``h``.
-    dim : 1, 2 or 3; only the first ``dim`` coordinates count in distances.
-    radius_scale : the kernel support factor k: neighbours have
-        ``|r_ij| < k * max(h_i, h_j)``.
-    domain : a :class:`Domain` (periodic axes), or None (open in every axis).
-    sort : if True, spatially sort the arrays once at construction (:meth:`sort`
+    arrays : list of ParticleArray
+        Distinct names; each needs ``x`` (``y``, ``z`` up to ``dim``) and ``h``.
+    dim : int
+        1, 2 or 3; only the first ``dim`` coordinates count in distances.
+    radius_scale : float
+        The kernel support factor k: neighbours have ``|r_ij| < k * max(h_i, h_j)``.
+    domain : Domain or None
+        Periodic axes, or None (open in every axis).
+    sort : bool
+        If True, spatially sort the arrays once at construction (:meth:`sort`
         permutes them in place).
 
     The cells are built at construction and by :meth:`update`, which takes a copy of
