@@ -114,6 +114,8 @@ class NeighbourSearch:
         If True, spatially sort the arrays once at construction (:meth:`sort`
         permutes them in place).
 
+    Notes
+    -----
     The cells are built at construction and by :meth:`update`, which takes a copy of
     the positions and ``h``: the lists describe the particles as they were at the
     last update, so call it whenever positions or ``h`` changed.
