@@ -71,28 +71,31 @@ def main(argv=None):
 
     cold = run_sphgen(o.nx, o.tf, 2, work, cache=os.path.join(work, "cache"))
     res["sphgen_compile_s"] = cold["compile_time"]
+    py = None if o.no_pysph else find_pysph_python()
+    # interleave the codes so a drift in machine speed hits both alike
+    ours = {1: [], 2: []}
+    theirs = {1: [], 2: []}
+    for _ in range(o.repeat):
+        for threads in (1, 2):
+            ours[threads].append(run_sphgen(o.nx, o.tf, threads, work))
+            if py:
+                theirs[threads].append(run_pysph(py, nx=o.nx, tf=o.tf, openmp=threads > 1,
+                                                 threads=threads if threads > 1 else None,
+                                                 workdir=os.path.join(work, f"pysph_{threads}")))
     for threads in (1, 2):
-        runs = [run_sphgen(o.nx, o.tf, threads, work) for _ in range(o.repeat)]
-        res[f"sphgen_{threads}"] = summarise_sphgen(runs)
+        res[f"sphgen_{threads}"] = summarise_sphgen(ours[threads])
     s1, s2 = res["sphgen_1"], res["sphgen_2"]
     res["sphgen_speedup_1_to_2"] = s1["wall_s"] / s2["wall_s"]
-
-    py = None if o.no_pysph else find_pysph_python()
-    if py:
-        for key, omp, thr in (("pysph_1", False, None), ("pysph_2", True, 2)):
-            runs = [run_pysph(py, nx=o.nx, tf=o.tf, openmp=omp, threads=thr,
-                              workdir=os.path.join(work, key)) for _ in range(o.repeat)]
-            ok = [r for r in runs if r["returncode"] == 0 and r.get("us_per_real_particle_step")]
-            if not ok:
-                res[key] = {"error": runs[0].get("stdout_tail", "")[-500:]}
-                continue
-            res[key] = {"run_s": statistics.median(r["run_s"] for r in ok),
-                        "us_per_particle_step": statistics.median(r["us_per_real_particle_step"] for r in ok),
-                        "steps": ok[0]["steps"], "n_real": ok[0]["n_real"], "n_array": ok[0]["n_array"],
-                        "other_cpu_s": [round(r["other_cpu_s"] or 0, 2) for r in ok]}
-        for t in (1, 2):
-            if "us_per_particle_step" in res.get(f"pysph_{t}", {}):
-                res[f"ratio_{t}"] = res[f"pysph_{t}"]["us_per_particle_step"] / res[f"sphgen_{t}"]["us_per_particle_step"]
+    for t in (1, 2) if py else ():
+        ok = [r for r in theirs[t] if r["returncode"] == 0 and r.get("us_per_real_particle_step")]
+        if not ok:
+            res[f"pysph_{t}"] = {"error": theirs[t][0].get("stdout_tail", "")[-500:]}
+            continue
+        res[f"pysph_{t}"] = {"run_s": statistics.median(r["run_s"] for r in ok),
+                             "us_per_particle_step": statistics.median(r["us_per_real_particle_step"] for r in ok),
+                             "steps": ok[0]["steps"], "n_real": ok[0]["n_real"], "n_array": ok[0]["n_array"],
+                             "other_cpu_s": [round(r["other_cpu_s"] or 0, 2) for r in ok]}
+        res[f"ratio_{t}"] = res[f"pysph_{t}"]["us_per_particle_step"] / res[f"sphgen_{t}"]["us_per_particle_step"]
     res["load_end"] = os.getloadavg()[0]
 
     print(f"Taylor-Green EDAC nx={o.nx} ({o.nx * o.nx} particles), tf={o.tf}, medians of {o.repeat}")

@@ -22,7 +22,7 @@ class Solver:
 
     def __init__(self, scene, integrator, dt, tf, *, adaptive=False, dt_props=("dt_cfl",), cfl=1.0,
                  max_steps=None, pfreq=100, output_at_times=(), outdir=None, prefix="sphgen",
-                 disable_output=False, progress=True, guard=True, speed_limit=None):
+                 disable_output=False, progress=True, guard=True, speed_limit=None, sort_every=50):
         if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
             raise ValueError(f"time step dt={dt!r} must be a positive finite number")
         if not (math.isfinite(tf) and tf >= 0):
@@ -50,6 +50,9 @@ class Solver:
         self.progress = progress
         self.guard = guard
         self.speed_limit = speed_limit
+        # particles drift away from their memory neighbours; re-sorting keeps the
+        # neighbour loops cache-friendly (carry a 'gid' property to track particles)
+        self.sort_every = sort_every
         self.t = 0.0
         self.step = 0
         self.post_step_callbacks = []
@@ -173,6 +176,8 @@ class Solver:
                     if self.speed_limit is not None:
                         self._check_speed(dt)
                     self._snapshot()
+                if self.sort_every and self.step % self.sort_every == 0:
+                    self.scene.sort()
                 for cb in self.post_step_callbacks:
                     cb(self)
                 if self._should_output(tprev):
