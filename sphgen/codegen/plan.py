@@ -160,24 +160,9 @@ class Plan:
                 gps.append(eps)
             self.groups.append(list(zip(groups, gps)))
         self.steppers = [StepperPlan(a, s, i) for i, (a, s) in enumerate(sorted(steppers.items()))]
-        dead = {}
-        first = True
-        while True:
-            self._specialise(dead)
-            if first:
-                self._check_exist()
-                first = False
-            self._prune()
-            new = {}
-            for ep in self.eqplans:
-                if ep.kept and not ep.eq.keep:
-                    d = {f"d_{p}" for a, p in ep.writes() if (a, p) not in self.needed}
-                    if d:
-                        new[id(ep.eq)] = d | dead.get(id(ep.eq), set())
-            if all(new.get(k, set()) <= dead.get(k, set()) for k in new):
-                break
-            for k, v in new.items():
-                dead[k] = dead.get(k, set()) | v
+        self._specialise({})
+        self._check_exist()
+        self._prune_to_fixed_point()
         self._check_properties()
         self.group_plans = []
         gi = 0
@@ -238,6 +223,27 @@ class Plan:
                 sp = specialise(st.stepper, m, consts, st.prefix, dim=self.dim)
                 if not sp.empty:
                     st.stages[m] = sp
+
+    def _prune_to_fixed_point(self):
+        """Prune equations, then stores nothing reads, until neither changes.
+
+        Removing a dead store can make an equation's other reads unneeded, which can
+        make another equation dead, and so on.
+        """
+        dead = {}
+        while True:
+            self._prune()
+            new = {}
+            for ep in self.eqplans:
+                if ep.kept and not ep.eq.keep:
+                    d = {f"d_{p}" for a, p in ep.writes() if (a, p) not in self.needed}
+                    if d:
+                        new[id(ep.eq)] = d | dead.get(id(ep.eq), set())
+            if all(new.get(k, set()) <= dead.get(k, set()) for k in new):
+                return
+            for k, v in new.items():
+                dead[k] = dead.get(k, set()) | v
+            self._specialise(dead)
 
     def _prune(self):
         """Keep an equation only if something needs what it writes (fixed point)."""
