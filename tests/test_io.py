@@ -12,7 +12,7 @@ from sphgen import io
 from sphgen.particles import ParticleArray
 
 
-def make_arrays(n_fluid=5, n_wall=3, seed=0):
+def make_arrays(n_fluid=5, n_solid=3, seed=0):
     rng = np.random.default_rng(seed)
     fluid = ParticleArray("fluid", x=rng.random(n_fluid), y=rng.random(n_fluid),
                           z=rng.random(n_fluid), rho=1000 + rng.random(n_fluid))
@@ -22,10 +22,10 @@ def make_arrays(n_fluid=5, n_wall=3, seed=0):
     fluid.add_property("unused", stride=3, default=2.5)  # declared, never allocated
     fluid.add_constant("c0", 10.0)
     fluid.add_constant("gravity", [0.0, -9.81, 0.0])
-    wall = ParticleArray("wall", x=rng.random(n_wall), y=rng.random(n_wall), z=np.zeros(n_wall))
-    wall.add_property("normal", stride=3, data=rng.random(3 * n_wall))
-    wall.add_constant("u_wall", [1.5, 0.0, 0.0])
-    return [fluid, wall]
+    solid = ParticleArray("solid", x=rng.random(n_solid), y=rng.random(n_solid), z=np.zeros(n_solid))
+    solid.add_property("normal", stride=3, data=rng.random(3 * n_solid))
+    solid.add_constant("u_solid", [1.5, 0.0, 0.0])
+    return [fluid, solid]
 
 
 def assert_same_array(a, b):
@@ -52,7 +52,7 @@ def test_round_trip(tmp_path, compress):
     path = tmp_path / "run_000123.h5"
     io.write(path, arrays, sd, compress=compress)
     out = io.load(path)
-    assert list(out["arrays"]) == ["fluid", "wall"]
+    assert list(out["arrays"]) == ["fluid", "solid"]
     for a in arrays:
         assert_same_array(a, out["arrays"][a.name])
     got = out["solver_data"]
@@ -200,7 +200,7 @@ def test_write_xdmf(tmp_path):
     for step in steps:
         assert step.get("CollectionType") == "Spatial"
         grids = step.findall("Grid")
-        assert [g.get("Name") for g in grids] == ["fluid", "wall"]
+        assert [g.get("Name") for g in grids] == ["fluid", "solid"]
         fluid = grids[0]
         topo = fluid.find("Topology")
         assert topo.get("TopologyType") == "Polyvertex" and topo.get("NumberOfElements") == "5"
@@ -216,7 +216,7 @@ def test_write_xdmf(tmp_path):
         assert "unused" not in atts
         assert atts["vel"].find("DataItem").get("Dimensions") == "5 3"
         assert atts["tau"].find("DataItem").get("Dimensions") == "5 9"
-    assert n_refs == 3 * ((3 + 7) + (3 + 4))  # per file: fluid and wall geometry + attributes
+    assert n_refs == 3 * ((3 + 7) + (3 + 4))  # per file: fluid and solid geometry + attributes
     assert not [f for f in os.listdir(tmp_path) if ".tmp-" in f]
 
 
