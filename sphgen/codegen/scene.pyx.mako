@@ -5,7 +5,17 @@ from libc.math cimport *
 cimport numpy as cnp
 import numpy as np
 from cython.parallel cimport prange
-cimport openmp
+
+cdef extern from *:
+    """
+    #ifdef _OPENMP
+    #include <omp.h>
+    static void sphgen_set_omp_threads(int n) { omp_set_num_threads(n); }
+    #else
+    static void sphgen_set_omp_threads(int n) { (void)n; }
+    #endif
+    """
+    void sphgen_set_omp_threads(int n) noexcept nogil
 cnp.import_array()
 
 cdef int _nthreads = 1
@@ -166,4 +176,4 @@ def set_threads(int n):
     """Threads of this module's loops; also the OpenMP default, which the neighbour search uses."""
     global _nthreads
     _nthreads = max(1, n)
-    openmp.omp_set_num_threads(_nthreads)
+    sphgen_set_omp_threads(_nthreads)
