@@ -125,3 +125,11 @@ def test_loop_counters_are_declared_int_and_helpers_translate():
         expect = np.linalg.det(pa.A.reshape(-1, 3, 3))
         assert np.allclose(res["cython"], expect, rtol=1e-12, atol=1e-14)
         assert np.allclose(res["python"], expect, rtol=1e-12, atol=1e-14)
+
+
+def test_pair_loop_accumulators_live_in_registers():
+    """d_au[d_idx] += ... over the neighbours accumulates in a local, stored once."""
+    sc = _scene(["u", "omega"], alpha=0.5)
+    src = sc.source
+    assert "_r_au = fluid_au[d_idx]" in src and "fluid_au[d_idx] = _r_au" in src
+    assert "&_r_au" in src and "d_au[0] +=" in src

@@ -7,7 +7,7 @@ import types
 from mako.template import Template
 
 from ..equation import PAIR_METHODS
-from .translate import TranslationError, specialise, to_cython
+from .translate import TranslationError, in_registers, indexed_only_by_d_idx, specialise, to_cython
 
 _TEMPLATE = os.path.join(os.path.dirname(__file__), "scene.pyx.mako")
 VERSION = "0.1"
@@ -80,10 +80,28 @@ def nbr_key(dest, src, reference):
     return f"{'rnb' if reference else 'nb'}_{dest}_{src}"
 
 
-def _call(sp, dest, src=None, key=None):
+def register_accumulators(plan, dest, sources):
+    """Destination doubles the pair loops of a pass write, always as ``d_X[d_idx]``."""
+    writes, bad = set(), set()
+    for lps in sources.values():
+        for ep in lps:
+            for m in PAIR_METHODS:
+                sp = ep.methods.get(m)
+                if sp is None:
+                    continue
+                d_args = {a for a in sp.args if a.startswith("d_") and a != "d_idx"}
+                good = indexed_only_by_d_idx(sp)
+                bad |= d_args - good
+                writes |= {a for a in sp.writes if a.startswith("d_")}
+    return {a[2:] for a in writes - bad if plan.dtype(dest, a[2:]) == "double"}
+
+
+def _call(sp, dest, src=None, key=None, regs=()):
     args = []
     for a in sp.args:
-        if a.startswith("d_") and a != "d_idx":
+        if a.startswith("d_") and a != "d_idx" and a[2:] in regs:
+            args.append(f"&_r_{a[2:]}")
+        elif a.startswith("d_") and a != "d_idx":
             args.append(f"{dest}_{a[2:]}")
         elif a.startswith("s_") and a != "s_idx":
             args.append(f"{src}_{a[2:]}")
@@ -145,11 +163,19 @@ def render(plan):
         return sp.fdef.name[: -len(sp.method) - 1]
 
     passes, nbr_keys = [], []
+    pair_specs = {}   # (equation, method) -> the version with register accumulators
+
+    def pair(ep, m):
+        return pair_specs.get((id(ep.eq), m), ep.methods[m])
     for row in plan.group_plans:
         for gp in row:
             for dest, eps in gp.dests.items():
+                regs = register_accumulators(plan, dest, gp.sources(dest))
                 for ep in eps:
                     for m, sp in ep.methods.items():
+                        if m in PAIR_METHODS and regs:
+                            sp = in_registers(sp, {f"d_{x}" for x in regs} & set(sp.args))
+                            pair_specs[(id(ep.eq), m)] = sp
                         dt = {}
                         for a in sp.args:
                             if a.startswith("d_") and a != "d_idx":
@@ -164,6 +190,7 @@ def render(plan):
                 p = _Obj(name=f"g{gp.index}_{dest}", dest=dest, initialize=[], post_loop=[], sources=[])
                 p.initialize = [_call(ep.methods["initialize"], dest) for ep in eps if "initialize" in ep.methods]
                 p.post_loop = [_call(ep.methods["post_loop"], dest) for ep in eps if "post_loop" in ep.methods]
+                p.registers = [(x, f"{dest}_{x}") for x in sorted(regs)]
                 syms_all = set()
                 for src, lps in gp.sources(dest).items():
                     key = nbr_key(dest, src, gp.group.reference)
@@ -171,14 +198,16 @@ def render(plan):
                         nbr_keys.append(key)
                     syms = {a for ep in lps for m in PAIR_METHODS if m in ep.methods
                             for a in ep.methods[m].pair_symbols}
-                    calls = [_call(ep.methods["loop"], dest, src, key) for ep in lps if "loop" in ep.methods]
-                    alls = [_call(ep.methods["loop_all"], dest, src, key) for ep in lps if "loop_all" in ep.methods]
+                    calls = [_call(pair(ep, "loop"), dest, src, key, regs) for ep in lps if "loop" in ep.methods]
+                    alls = [_call(pair(ep, "loop_all"), dest, src, key, regs) for ep in lps
+                            if "loop_all" in ep.methods]
                     symbols = pair_symbol_code(syms, dest, src, plan.dim, plan.domain, gp.group.reference) \
                         if calls else []
                     if calls:
                         syms_all |= pair_symbols_needed(syms)
                     p.sources.append(_Obj(name=src, key=key, symbols=symbols, calls=calls, loop_all=alls))
                 decls = ["cdef long s_idx = 0", "cdef long _k = 0", "cdef double _f = 0.0"]
+                decls += [f"cdef double _r_{x} = 0.0" for x, _ in p.registers]
                 for s in ("XIJ", "VIJ", "DWIJ"):
                     if s in syms_all:
                         # components past the dimension are zero (set once, never recomputed)

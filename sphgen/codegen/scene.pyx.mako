@@ -69,6 +69,9 @@ cdef void _pass_${p.name}(long d_idx, double t, double dt) noexcept nogil:
 % for call in p.initialize:
     ${call}
 % endfor
+% for x, arr in p.registers:
+    _r_${x} = ${arr}[d_idx]
+% endfor
 % for src in p.sources:
     # source ${src.name}
     for _k in range(${src.key}_off[d_idx], ${src.key}_off[d_idx + 1]):
@@ -82,6 +85,9 @@ cdef void _pass_${p.name}(long d_idx, double t, double dt) noexcept nogil:
 % for call in src.loop_all:
     ${call}
 % endfor
+% endfor
+% for x, arr in p.registers:
+    ${arr}[d_idx] = _r_${x}
 % endfor
 % for call in p.post_loop:
     ${call}

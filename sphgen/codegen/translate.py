@@ -228,6 +228,44 @@ class Specialised:
         return [a for a in self.args if a in PAIR_SYMBOLS]
 
 
+def indexed_only_by_d_idx(spec):
+    """d_* arguments every access of which is ``d_X[d_idx]``."""
+    ok = {a for a in spec.args if a.startswith("d_") and a != "d_idx"}
+    for node in ast.walk(spec.fdef):
+        if isinstance(node, ast.Subscript) and isinstance(node.value, ast.Name) and node.value.id in ok:
+            if not (isinstance(node.slice, ast.Name) and node.slice.id == "d_idx"):
+                ok.discard(node.value.id)
+        elif isinstance(node, ast.Name) and node.id in ok:
+            pass
+    # a bare use (passing the pointer on) also disqualifies
+    subs = {id(n.value) for n in ast.walk(spec.fdef) if isinstance(n, ast.Subscript)}
+    for node in ast.walk(spec.fdef):
+        if isinstance(node, ast.Name) and node.id in ok and id(node) not in subs:
+            ok.discard(node.id)
+    return ok
+
+
+def in_registers(spec, names):
+    """A copy of ``spec`` where ``d_X[d_idx]`` reads/writes ``d_X[0]`` for X in names.
+
+    The neighbour pass then hands these equations the address of a local accumulator,
+    so ``d_au[d_idx] += ...`` over all neighbours stays in a register instead of a
+    load-add-store through memory per pair.
+    """
+    import copy
+
+    class _Rewrite(ast.NodeTransformer):
+        def visit_Subscript(self, node):
+            self.generic_visit(node)
+            if isinstance(node.value, ast.Name) and node.value.id in names:
+                node.slice = ast.copy_location(ast.Constant(0), node.slice)
+            return node
+
+    new = copy.copy(spec)
+    new.fdef = ast.fix_missing_locations(_Rewrite().visit(copy.deepcopy(spec.fdef)))
+    return new
+
+
 def _usage(fdef):
     """(reads, writes): sets of argument names read / written through subscripts."""
     reads, writes, stored = set(), set(), set()
