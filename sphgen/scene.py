@@ -159,11 +159,32 @@ class Scene:
     def describe(self):
         return self.plan.describe()
 
-    def check_finite(self):
-        """None if all allocated float data is finite, else (array, prop, particle index)."""
+    def max_speed2(self):
+        """[(array, largest |u|^2, its particle index)] over arrays with velocities."""
+        if self.module is not None:
+            return self.module.max_speed2()
+        out = []
         for pa in self.arrays:
-            for name, arr in pa.data.items():
-                if arr.dtype.kind == "f" and not np.isfinite(arr.sum()):
-                    bad = int(np.flatnonzero(~np.isfinite(arr))[0]) // pa.props[name].stride
-                    return pa.name, name, bad
+            comps = [pa.data[u] for u in ("u", "v", "w")[:self.dim] if u in pa.data]
+            if comps and pa.n:
+                s2 = sum(c * c for c in comps)
+                i = int(np.argmax(s2))
+                out.append((pa.name, float(s2[i]), i))
+        return out
+
+    def check_finite(self):
+        """None if all allocated float data is finite, else (array, prop, particle index).
+
+        The compiled module scans in parallel; numpy finds the particle only on failure.
+        """
+        if self.module is not None:
+            bad = self.module.count_nonfinite()
+            candidates = [(self.by_name[a], p) for a, p, _ in bad]
+        else:
+            candidates = [(pa, name) for pa in self.arrays for name in pa.data]
+        for pa, name in candidates:
+            arr = pa.data[name]
+            if arr.dtype.kind == "f" and not np.isfinite(arr.sum()):
+                i = int(np.flatnonzero(~np.isfinite(arr))[0]) // pa.props[name].stride
+                return pa.name, name, i
         return None

@@ -199,15 +199,11 @@ class Solver:
 
     def _check_speed(self, dt):
         """A particle faster than the scheme's limit (e.g. Mach 1 for weak compressibility)."""
-        for pa in self.scene.arrays:
-            comps = [pa.data[u] for u in ("u", "v", "w")[:self.scene.dim] if u in pa.data]
-            if comps and pa.n:
-                speed2 = sum(c * c for c in comps)
-                i = int(np.argmax(speed2))
-                if speed2[i] > self.speed_limit ** 2:
-                    what = (f"speed {np.sqrt(speed2[i]):.3g} of {pa.name} particle {i} exceeds the "
-                            f"scheme's limit {self.speed_limit:.3g}")
-                    self._blow_up(None, dt, what)
+        for name, speed2, i in self.scene.max_speed2():
+            if speed2 > self.speed_limit ** 2:
+                what = (f"speed {np.sqrt(speed2):.3g} of {name} particle {i} exceeds the "
+                        f"scheme's limit {self.speed_limit:.3g}")
+                self._blow_up(None, dt, what)
 
     def _blow_up(self, bad, dt, what=None):
         if what is None:

@@ -227,9 +227,14 @@ def render(plan):
     allocation = [(name, [(p, _ctype(plan.dtype(name, p))) for p in sorted(props)])
                   for name, props in plan.allocation.items()]
     constants = [(name, sorted(pa.constants)) for name, pa in plan.arrays.items() if pa.constants]
+    guarded = [(name, [(p, plan.arrays[name].props[p].stride) for p in sorted(props)
+                       if plan.dtype(name, p) == "double"])
+               for name, props in plan.allocation.items()]
     src = Template(filename=_TEMPLATE).render(
         version=VERSION, allocation=allocation, constants=constants, nbr_keys=nbr_keys,
         param_globals=sorted(params), kernel_name=type(kernel).__name__, dim=plan.dim,
         kernel_code=kernel_code, helper_code=helper_code, method_code=method_code,
-        passes=passes, stages=stages)
+        passes=passes, stages=stages, guarded=guarded,
+        moving=[(name, [u for u in ("u", "v", "w")[:plan.dim] if u in props])
+                for name, props in plan.allocation.items() if "u" in props])
     return src, params

@@ -113,6 +113,45 @@ def stage_${s.name}(double t, double dt):
             ${s.call}
 
 % endfor
+# ---------------------------------------------------------------- blow-up guard
+def count_nonfinite():
+    """[(array, property, count of non-finite values)], scanned in parallel."""
+    cdef long i
+    cdef long bad
+    out = []
+% for arr, props in guarded:
+% for prop, stride in props:
+    bad = 0
+    with nogil:
+        for i in prange(${arr}_n * ${stride}, num_threads=_nthreads, schedule='static'):
+            if not isfinite(${arr}_${prop}[i]):
+                bad += 1
+    if bad:
+        out.append(('${arr}', '${prop}', bad))
+% endfor
+% endfor
+    return out
+
+
+def max_speed2():
+    """[(array, largest |u|^2, its particle)] for the arrays with velocities."""
+    cdef long i, im
+    cdef double m, s2
+    out = []
+% for arr, comps in moving:
+    m = 0.0
+    im = -1
+    with nogil:
+        for i in range(${arr}_n):
+            s2 = ${" + ".join(f"{arr}_{u}[i] * {arr}_{u}[i]" for u in comps)}
+            if s2 > m:
+                m = s2
+                im = i
+    out.append(('${arr}', m, im))
+% endfor
+    return out
+
+
 # ---------------------------------------------------------------- binding
 cdef void* _ptr(object a, str what) except NULL:
     if not isinstance(a, cnp.ndarray) or not (<cnp.ndarray>a).flags['C_CONTIGUOUS']:
