@@ -235,8 +235,6 @@ def indexed_only_by_d_idx(spec):
         if isinstance(node, ast.Subscript) and isinstance(node.value, ast.Name) and node.value.id in ok:
             if not (isinstance(node.slice, ast.Name) and node.slice.id == "d_idx"):
                 ok.discard(node.value.id)
-        elif isinstance(node, ast.Name) and node.id in ok:
-            pass
     # a bare use (passing the pointer on) also disqualifies
     subs = {id(n.value) for n in ast.walk(spec.fdef) if isinstance(n, ast.Subscript)}
     for node in ast.walk(spec.fdef):
