@@ -140,13 +140,13 @@ def l_shape(xmin, xmax, ymin, ymax, wx, wy, dx):
 
 # ------------------------------------------------------------------ masks
 def remove_inside(points, shape_fn):
-    """The points where shape_fn(*points) is False."""
+    """The points where ``shape_fn(*points)`` is False."""
     mask = np.asarray(shape_fn(*points), dtype=bool)
     return tuple(np.asarray(p)[~mask] for p in points)
 
 
 def keep_inside(points, shape_fn):
-    """The points where shape_fn(*points) is True."""
+    """The points where ``shape_fn(*points)`` is True."""
     mask = np.asarray(shape_fn(*points), dtype=bool)
     return tuple(np.asarray(p)[mask] for p in points)
 

@@ -74,7 +74,7 @@ def shepard(points, x, y, *rest, order=0):
 
     Call as ``shepard((px, py), x, y, h, m, rho, values, kernel)`` or, in 3D,
     ``shepard((px, py, pz), x, y, z, h, m, rho, values, kernel)``; h, m, rho may be scalars,
-    ``values`` is (n,) or (n, k).  W_ab = W(|r_a - r_b|, h_b), V_b = m_b/rho_b.  order=0
+    ``values`` is (n,) or (n, k).  ``W_ab = W(|r_a - r_b|, h_b)``, ``V_b = m_b/rho_b``.  order=0
     reproduces constants exactly; order=1 fits f_b ~ a + g.(r_b - r_a) by least squares with
     weights W_ab V_b and returns a, which reproduces linear fields exactly (falls back to
     order 0 where fewer than dim+1 non-collinear neighbours make the fit singular).  A point
