@@ -13,7 +13,7 @@ $(STAMP): setup.py pyproject.toml $(wildcard sphgen/nnps/*.pyx)
 	touch $(STAMP)
 
 run: $(STAMP)
-	$(VENV)/bin/sphgen run taylor_green --nx 50 --re 100 --tf 0.5 -d outputs/taylor_green
+	$(VENV)/bin/sphgen run taylor_green --nx 50 --re 100 --tf 0.5 -d outputs/taylor_green --overwrite
 
 test: $(STAMP)
 	$(PY) -m pytest -q

@@ -13,6 +13,7 @@ import numpy as np
 
 from sphgen import io
 from sphgen.app import Application
+from sphgen.errors import InputError
 from sphgen.nnps import Domain
 from sphgen.particles import ParticleArray
 
@@ -39,6 +40,7 @@ class TaylorGreen(Application):
     tf = 0.5
     pfreq = 200
     dim = 2
+    history_columns = ("t", "max_u", "max_u_exact", "l1_error")
 
     def add_user_options(self, group):
         group.add_argument("--nx", type=int, default=50, help="particles per side (default %(default)s)")
@@ -54,18 +56,17 @@ class TaylorGreen(Application):
 
     def consume_user_options(self, o):
         if o.nx < 4:
-            raise SystemExit(f"--nx must be at least 4, got {o.nx}")
+            raise InputError(f"--nx must be at least 4, got {o.nx}")
         for name in ("re", "hdx", "c0"):
             v = getattr(o, name)
             if not (np.isfinite(v) and v > 0):
-                raise SystemExit(f"--{name} must be a positive finite number, got {v}")
+                raise InputError(f"--{name} must be a positive finite number, got {v}")
         if not (np.isfinite(o.perturb) and 0 <= o.perturb < 0.5):
-            raise SystemExit(f"--perturb must be in [0, 0.5), got {o.perturb}")
+            raise InputError(f"--perturb must be in [0, 0.5), got {o.perturb}")
         self.nx, self.re = o.nx, o.re
         self.dx = 1.0 / o.nx
         self.h = o.hdx * self.dx
         self.nu = 1.0 / o.re
-        self.history = []
 
     def create_particles(self):
         dx = self.dx
@@ -97,18 +98,29 @@ class TaylorGreen(Application):
             self.record(solver.t)
 
     def record(self, t):
-        f = self.scene.by_name["fluid"]
+        self.history.append(self.history_row(self.scene.by_name["fluid"], t, self.re))
+
+    @staticmethod
+    def history_row(f, t, re):
+        """[t, max |u|, its exact value, L1 error of |u|] of the fluid array ``f``."""
         vmag = np.hypot(f.u, f.v)
-        self.history.append((t, float(vmag.max()), float(np.exp(-8 * pi * pi * t / self.re)),
-                             l1_error(f.x, f.y, f.u, f.v, t, self.re)))
+        return [t, float(vmag.max()), float(np.exp(-8 * pi * pi * t / re)),
+                l1_error(f.x, f.y, f.u, f.v, t, re)]
+
+    def history_meta(self):
+        return {"re": self.re, "nx": self.nx}
 
     def post_process(self, outdir):
-        hist_path = os.path.join(outdir, "history.json")
-        if getattr(self, "history", None):
-            io.write_json(hist_path, {"columns": ["t", "max_u", "max_u_exact", "l1_error"],
-                                      "rows": self.history, "re": self.re, "nx": self.nx})
-        with open(hist_path) as f:
+        """results.json and decay.png from the run's files (history.json, outputs)."""
+        with open(os.path.join(outdir, "history.json")) as f:
             hist = json.load(f)
+        if not hist["rows"]:  # a run of zero steps: its state is the initial one
+            if self.solver is not None:
+                fluid, t = self.scene.by_name["fluid"], self.solver.t
+            else:
+                last = io.load(io.output_files(outdir, self.name)[-1])
+                fluid, t = last["arrays"]["fluid"], last["solver_data"]["t"]
+            hist["rows"] = [self.history_row(fluid, t, hist["re"])]
         rows = np.array(hist["rows"])
         t, umax, uex, l1 = rows.T
         results = {"t": float(t[-1]), "l1_error": float(l1[-1]), "max_u": float(umax[-1]),

@@ -11,7 +11,7 @@ class SphgenTask(CommandTask):
 
     def __init__(self, command, output_dir, job_info=None, depends=None):
         if isinstance(command, str):
-            command = command + " -d $output_dir --no-progress"
+            command = command + " -d $output_dir --no-progress --overwrite"
         super().__init__(command, output_dir, job_info, depends)
 
     def _is_done(self):

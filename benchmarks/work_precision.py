@@ -24,7 +24,7 @@ def sphgen_case(nx, tf, out, threads=2):
     d = os.path.join(out, f"sphgen_nx{nx}")
     exe = os.path.join(os.path.dirname(sys.executable), "sphgen")
     subprocess.run([exe, "run", "taylor_green", "--nx", str(nx), "--tf", str(tf), "--disable-output",
-                    "--no-progress", "--threads", str(threads), "-d", d], check=True,
+                    "--no-progress", "--threads", str(threads), "-d", d, "--overwrite"], check=True,
                    stdout=subprocess.DEVNULL)
     info = json.load(open(os.path.join(d, "info.json")))
     res = json.load(open(os.path.join(d, "results.json")))

@@ -3,6 +3,10 @@
 ``sphgen run NAME [options]`` imports ``sphgen.applications.NAME``, builds its
 Application and runs it; ``sphgen list`` names the applications.  Every run writes
 ``info.json`` in its output folder (automan's notion of a finished case).
+
+Everything a user can get wrong is checked before compiling and before any file is
+touched; a user mistake is one line on stderr and a non-zero exit (``--debug`` or
+``SPHGEN_DEBUG=1`` shows the traceback).  See docs/reliability.md.
 """
 import argparse
 import importlib
@@ -12,9 +16,10 @@ import pkgutil
 import sys
 import time
 
-from . import io
+from . import __version__, io, run_folder
+from .errors import InputError, SphgenError, debug_requested, one_line
 from .scene import Scene
-from .solver import BlowUpError, Solver
+from .solver import Solver
 
 
 def _positive_float(s):
@@ -38,22 +43,36 @@ def _positive_int(s):
     return v
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse whose mistakes are an InputError (one line), not a usage dump and exit."""
+
+    def error(self, message):
+        raise InputError(f"{self.prog}: {message} (see --help)")
+
+
 class Application:
     """Subclass and override ``create_particles`` and ``create_scheme``.
 
     Optional: ``create_domain``, ``add_user_options(parser)``,
     ``consume_user_options(options)``, ``post_step(solver)``, ``post_process(outdir)``.
     Class attributes ``tf`` and ``pfreq`` give the defaults of ``--tf``/``--pfreq``.
+
+    Time series: append rows (first column t) to ``self.history`` and name the columns in
+    ``history_columns``; ``history.json`` is written with every output, continues across
+    restarts, and carries ``history_meta()``.
     """
 
     tf = 1.0
     pfreq = 100
     dim = 2
+    history_columns = None
 
     def __init__(self, name=None):
         self.name = name or type(self).__module__.rsplit(".", 1)[-1]
         self.options = None
         self.scene = self.solver = self.scheme = None
+        self.history = []
+        self.restarts = []
 
     # ---------------------------------------------------------------- hooks
     def add_user_options(self, parser):
@@ -77,11 +96,15 @@ class Application:
     def post_process(self, outdir):
         pass
 
+    def history_meta(self):
+        """Extra keys of history.json (e.g. the case's parameters)."""
+        return {}
+
     # ---------------------------------------------------------------- CLI
-    def parser(self):
-        p = argparse.ArgumentParser(prog=f"sphgen run {self.name}", description=(type(self).__doc__ or "").strip())
+    @staticmethod
+    def _run_options(p):
         g = p.add_argument_group("run")
-        g.add_argument("--tf", type=_nonneg_float, default=self.tf, help="final time (default %(default)s)")
+        g.add_argument("--tf", type=_nonneg_float, help="final time (default %(default)s)")
         g.add_argument("--dt", type=_positive_float, default=None, help="time step (default: the scheme's)")
         g.add_argument("--max-steps", type=_positive_int, default=None, help="stop after this many steps")
         g.add_argument("--openmp", dest="openmp", action="store_true", default=True,
@@ -89,62 +112,143 @@ class Application:
         g.add_argument("--no-openmp", dest="openmp", action="store_false", help="run serial (one thread)")
         g.add_argument("--threads", type=_positive_int, default=None, help="number of threads")
         g.add_argument("-d", "--directory", default=None, help="output folder (default NAME_output)")
-        g.add_argument("--pfreq", type=_positive_int, default=self.pfreq, help="output every N steps")
+        g.add_argument("--overwrite", action="store_true",
+                       help="replace the files of another run in the output folder")
+        g.add_argument("--pfreq", type=_positive_int, help="output every N steps")
         g.add_argument("--disable-output", action="store_true", help="write no particle files")
         g.add_argument("--restart", metavar="FILE", default=None, help="continue from an output file")
+        g.add_argument("--allow-unstable", action="store_true",
+                       help="run even outside the scheme's stability bounds (a warning is printed)")
         g.add_argument("--show-plan", action="store_true", help="print the generator's plan and exit")
         g.add_argument("--backend", choices=("cython", "python"), default="cython",
                        help="compiled (default) or the slow plain-Python evaluator")
         g.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
+        g.add_argument("--debug", action="store_true", help="show tracebacks of errors")
+
+    def parser(self):
+        p = _Parser(prog=f"sphgen run {self.name}", description=(type(self).__doc__ or "").strip())
+        self._run_options(p)
+        p.set_defaults(tf=self.tf, pfreq=self.pfreq)
+        run_dests = set(vars(p.parse_args([])))
         self.add_user_options(p.add_argument_group(self.name))
+        self._user_dests = sorted(set(vars(p.parse_known_args([])[0])) - run_dests)
         return p
 
     def run(self, argv=None):
-        """Parse options, build the scene, run, write info.json, post-process."""
-        opts = self.parser().parse_args(argv)
-        self.options = opts
+        """Parse options, check them, build the scene, run, write info.json, post-process.
+
+        A user mistake prints one line to stderr and exits non-zero (SystemExit);
+        with ``--debug`` (or SPHGEN_DEBUG=1) the exception propagates with its traceback.
+        """
+        argv = sys.argv[1:] if argv is None else list(argv)
+        try:
+            return self._run(argv)
+        except SphgenError as e:
+            if debug_requested(argv):
+                raise
+            print(f"sphgen: {one_line(e)}", file=sys.stderr)
+            raise SystemExit(e.exit_code) from None
+
+    def _run(self, argv):
+        opts = self.options = self.parser().parse_args(argv)
         self.consume_user_options(opts)
-        outdir = opts.directory or f"{self.name}_output"
-        self.outdir = outdir
+        self.outdir = outdir = opts.directory or f"{self.name}_output"
+        restart = run_folder.read_restart(opts.restart) if opts.restart else None
+        if not opts.show_plan:
+            run_folder.check_output_folder(outdir, opts.overwrite, opts.restart)
         arrays = self.create_particles()
         self.scheme = self.create_scheme()
         self.scheme.setup_properties(arrays)
-        outputs = {pa.name: [p for p in self.scheme.output_props if pa.has(p)] for pa in arrays}
-        threads = 1 if not opts.openmp else opts.threads
+        dt = opts.dt or self.scheme.get_timestep()
+        for warning in self.scheme.check_stability(dt, opts.allow_unstable):
+            print(f"sphgen: warning: {warning}", file=sys.stderr)
+        self.signature = self._signature(arrays)
+        if restart is not None:
+            run_folder.check_restart(opts.restart, restart, self.signature, opts.tf)
         integrator = self.scheme.get_integrator()
-        self.scene = Scene(arrays, self.scheme.get_equations(), steppers=integrator.steppers,
-                           kernel=getattr(self.scheme, "kernel", None), dim=self.dim,
-                           domain=self.create_domain(), outputs=outputs, backend=opts.backend,
-                           threads=threads)
+        self.scene = self._scene(arrays, integrator)
         if opts.show_plan:
             print(self.scene.describe())
             if self.scene.source is not None:
                 print(f"generated source: {self.scene.source_path}")
             return None
-        dt = opts.dt or self.scheme.get_timestep()
-        self.solver = Solver(self.scene, integrator, dt, opts.tf, max_steps=opts.max_steps,
-                             pfreq=opts.pfreq, outdir=outdir, prefix=self.name,
-                             disable_output=opts.disable_output, progress=opts.progress,
-                             speed_limit=getattr(self.scheme, "speed_limit", None))
-        if opts.restart:
-            self.solver.restart_from(opts.restart)
-        self.solver.post_step_callbacks.append(self.post_step)
-        os.makedirs(outdir, exist_ok=True)
-        info = self._info(opts, completed=False)
-        io.write_json(os.path.join(outdir, "info.json"), info)
+        self.solver = self._solver(integrator, dt)
+        if restart is not None:
+            self._restart(opts.restart, restart, dt)
+        run_folder.prepare_output_folder(outdir, opts.overwrite, opts.restart)
+        return self._execute()
+
+    def _scene(self, arrays, integrator):
+        opts = self.options
+        outputs = {pa.name: [p for p in self.scheme.output_props if pa.has(p)] for pa in arrays}
+        return Scene(arrays, self.scheme.get_equations(), steppers=integrator.steppers,
+                     kernel=getattr(self.scheme, "kernel", None), dim=self.dim,
+                     domain=self.create_domain(), outputs=outputs, backend=opts.backend,
+                     threads=1 if not opts.openmp else opts.threads)
+
+    def _solver(self, integrator, dt):
+        opts = self.options
+        solver = Solver(self.scene, integrator, dt, opts.tf, max_steps=opts.max_steps,
+                        pfreq=opts.pfreq, outdir=self.outdir, prefix=self.name,
+                        disable_output=opts.disable_output, progress=opts.progress,
+                        speed_limit=self.scheme.speed_limit,
+                        density_bounds=self.scheme.density_bounds(),
+                        metadata={"signature": self.signature, "tf": opts.tf})
+        solver.post_step_callbacks.append(self.post_step)
+        solver.output_callbacks.append(lambda s, path: self._write_progress())
+        return solver
+
+    def _restart(self, path, data, dt):
+        """Continue the run of ``path``: its state, history and record of restarts."""
+        self.solver.restart_from(path)
+        for note in run_folder.restart_notes(data, dt, self.options.tf):
+            print(f"sphgen: restart: {note}")
+        hist = run_folder.earlier_history(path, self.solver.t)
+        if hist is not None:
+            self.history = [list(r) for r in hist["rows"]]
+        else:
+            print(f"sphgen: restart: no history.json beside {path}; the time series starts here")
+        if run_folder.same_folder(path, self.outdir):
+            self.restarts = list(run_folder.earlier_info(self.outdir).get("restarts", []))
+        self.restarts.append({"from": os.path.abspath(path), "t": self.solver.t, "step": self.solver.step,
+                              "at": time.strftime("%Y-%m-%dT%H:%M:%S")})
+
+    def _execute(self):
+        """Run the solver with info.json and history.json kept current; then post-process."""
+        outdir = self.outdir
+        self._write_progress()
         error = None
         try:
             self.solver.run()
-        except BlowUpError as e:
+        except SphgenError as e:
             error = str(e)
-        info = self._info(opts, completed=error is None, error=error)
-        io.write_json(os.path.join(outdir, "info.json"), info)
+            self._write_progress(error=error)
+            raise
+        finally:
+            if error is None:
+                self._write_progress(completed=True)
         print(f"{self.name}: {self.solver.step} steps to t={self.solver.t:.6g} in {self.solver.wall_time:.2f} s "
               f"(compile {self.scene.compile_time:.2f} s, {self.scene.threads} thread(s)); output in {outdir}")
-        if error:
-            raise BlowUpError(error)
         self.post_process(outdir)
-        return info
+        return self._info(True)
+
+    def _write_progress(self, completed=False, error=None):
+        """info.json and history.json as they stand now (both atomic)."""
+        if self.history_columns is not None:
+            io.write_json(os.path.join(self.outdir, "history.json"),
+                          {"columns": list(self.history_columns), "rows": self.history, **self.history_meta()})
+        io.write_json(os.path.join(self.outdir, "info.json"), self._info(completed, error))
+
+    def _signature(self, arrays):
+        """What defines the scene: a restart must agree on all of it."""
+        opts = self.options
+        kernel = getattr(self.scheme, "kernel", None)
+        return {"application": self.name, "scheme": type(self.scheme).__name__,
+                "scheme_parameters": self.scheme.parameters(),
+                "options": {k: getattr(opts, k) for k in self._user_dests},
+                "particles": {pa.name: pa.n for pa in arrays},
+                "kernel": type(kernel).__name__ if kernel is not None else None,
+                "dim": self.dim, "sphgen_version": __version__}
 
     def neighbour_pairs_per_step(self):
         """Neighbour pairs visited in one step (all evaluations and passes)."""
@@ -162,8 +266,8 @@ class Application:
                         total += int(off[-1]) * max(1, gp.group.iterations)
         return total
 
-    def _info(self, opts, completed, error=None):
-        s, sc = self.solver, self.scene
+    def _info(self, completed, error=None):
+        s, sc, opts = self.solver, self.scene, self.options
         n = sum(pa.n for pa in sc.arrays)
         steps = max(s.step, 1)
         return {
@@ -174,7 +278,8 @@ class Application:
             "time_per_particle_step": s.wall_time / (steps * max(n, 1)),
             "neighbour_pairs_per_step": self.neighbour_pairs_per_step() if completed else None,
             "generated_source": getattr(sc, "source_path", None),
-            "options": vars(opts), "finished_at": time.strftime("%Y-%m-%dT%H:%M:%S"),
+            "restarts": self.restarts, "options": vars(opts),
+            "finished_at": time.strftime("%Y-%m-%dT%H:%M:%S"),
         }
 
 
@@ -209,11 +314,7 @@ def main(argv=None):
         return 0
     if argv[0] != "run" or len(argv) < 2:
         raise SystemExit(f"sphgen: unknown command {' '.join(argv)!r}; try 'sphgen run NAME' or 'sphgen list'")
-    app = load_application(argv[1])()
-    try:
-        app.run(argv[2:])
-    except BlowUpError as e:
-        raise SystemExit(f"sphgen: the run blew up: {e}")
+    load_application(argv[1])().run(argv[2:])
     return 0
 
 

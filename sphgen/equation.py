@@ -14,9 +14,15 @@ Properties are named by argument: ``d_rho`` is property ``rho`` of the destinati
 GHIJ, EPS``) are computed only when a ``loop`` asks for them.  Pair loops write only
 ``d_*[d_idx]`` (gather-only), which keeps the OpenMP loops race-free.
 """
+import ast
+import difflib
+import inspect
 import math
+import textwrap
 
 from compyle.api import declare  # noqa: F401  (re-exported: ``from sphgen.equation import declare``)
+
+from .errors import SphgenError
 
 PAIR_SYMBOLS = ("XIJ", "RIJ", "R2IJ", "VIJ", "HIJ", "WIJ", "DWIJ", "WDASHIJ", "GHIJ", "EPS")
 VECTOR_SYMBOLS = ("XIJ", "VIJ", "DWIJ")
@@ -25,7 +31,7 @@ PAIR_METHODS = ("loop", "loop_all")
 COMPILED_METHODS = ("initialize", "loop", "loop_all", "post_loop")
 
 
-class ParameterError(ValueError):
+class ParameterError(SphgenError, ValueError):
     """An equation parameter is negative, non-finite or unknown."""
 
 
@@ -37,6 +43,33 @@ def helper(func):
     """
     func.__sphgen_helper__ = True
     return func
+
+
+_KNOWN = {}
+
+
+def known_parameters(cls):
+    """Parameter names an equation class uses: ``self.<name>`` in its methods' source.
+
+    Empty when a class's source cannot be read (e.g. typed at a prompt): then any
+    keyword is accepted.
+    """
+    if cls not in _KNOWN:
+        names = set()
+        for klass in cls.__mro__:
+            if klass in (Equation, object):
+                continue
+            try:
+                tree = ast.parse(textwrap.dedent(inspect.getsource(klass)))
+            except (OSError, TypeError, SyntaxError):
+                _KNOWN[cls] = set()
+                return _KNOWN[cls]
+            names |= {n.attr for n in ast.walk(tree) if isinstance(n, ast.Attribute)
+                      and isinstance(n.value, ast.Name) and n.value.id == "self"}
+            names |= set(getattr(klass, "switches", ())) | set(getattr(klass, "positive", ()))
+            names |= set(getattr(klass, "nonnegative", ()))
+        _KNOWN[cls] = names
+    return _KNOWN[cls]
 
 
 class Equation:
@@ -60,6 +93,13 @@ class Equation:
         if isinstance(sources, str):
             sources = [sources]
         self.sources = list(sources) if sources else []
+        known = known_parameters(type(self))
+        unknown = sorted(set(params) - known) if known else []
+        if unknown:
+            close = difflib.get_close_matches(unknown[0], sorted(known), n=1)
+            hint = f"; did you mean '{close[0]}'?" if close else ""
+            raise ParameterError(f"{type(self).__name__}(dest='{dest}'): unknown parameter "
+                                 f"'{unknown[0]}'{hint}")
         for k, v in params.items():
             setattr(self, k, v)
         self.check_parameters()

@@ -161,6 +161,12 @@ def load(path):
     return {"arrays": arrays, "solver_data": solver_data}
 
 
+def read_solver_data(path):
+    """The solver data (t, dt, step, and what the run stored with them) of an output file."""
+    with _open(path) as f:
+        return json.loads(f["solver_data"].attrs["json"])
+
+
 def output_files(directory, prefix=None):
     """Output files ``<prefix>_<step>.h5`` of a directory, sorted by step (full paths)."""
     found = []
@@ -210,8 +216,44 @@ def _array_grid(parent, fname, g):
     return grid
 
 
-def write_xdmf(directory, prefix=None):
-    """(Re)write ``<directory>/<prefix>.xdmf`` indexing all output files; returns its path."""
+class XdmfIndex:
+    """The XDMF index of one output series, rewritten atomically after every output.
+
+    Each output file is opened once, when it is added; the index lists only the files
+    added to it, so files of another run in the same folder never enter it.
+    """
+
+    def __init__(self, directory, prefix):
+        self.directory, self.prefix = os.fspath(directory), prefix
+        self.path = os.path.join(self.directory, f"{prefix}.xdmf")
+        self._steps = {}
+
+    def add(self, path):
+        """Index one output file (replacing an earlier entry of the same step)."""
+        fname = os.path.basename(path)  # the xdmf lives in the same folder: relative paths
+        with _open(path) as f:
+            sd = f["solver_data"].attrs
+            step = ET.Element("Grid", Name=f"step_{int(sd['step'])}", GridType="Collection",
+                              CollectionType="Spatial")
+            ET.SubElement(step, "Time", Value=repr(float(sd["t"])))
+            for g in f["arrays"].values():
+                _array_grid(step, fname, g)
+            self._steps[int(sd["step"])] = step
+
+    def write(self):
+        """(Re)write the index file atomically; returns its path."""
+        root = ET.Element("Xdmf", Version="3.0")
+        series = ET.SubElement(ET.SubElement(root, "Domain"), "Grid", Name=self.prefix,
+                               GridType="Collection", CollectionType="Temporal")
+        for step in sorted(self._steps):
+            series.append(self._steps[step])
+        ET.indent(root)
+        _write_text(self.path, '<?xml version="1.0" ?>\n' + ET.tostring(root, encoding="unicode") + "\n")
+        return self.path
+
+
+def write_xdmf(directory, prefix=None, max_step=None):
+    """(Re)write ``<directory>/<prefix>.xdmf`` indexing the series' files; returns its path."""
     files = output_files(directory, prefix)
     if prefix is None:
         prefixes = {_SERIES.match(os.path.basename(p))["prefix"] for p in files}
@@ -219,19 +261,52 @@ def write_xdmf(directory, prefix=None):
             raise ValueError(f"{directory}: cannot tell which output series to index "
                              f"(prefixes found: {sorted(prefixes) or 'none'}); pass prefix=")
         prefix = prefixes.pop()
-    root = ET.Element("Xdmf", Version="3.0")
-    series = ET.SubElement(ET.SubElement(root, "Domain"), "Grid", Name=prefix,
-                           GridType="Collection", CollectionType="Temporal")
+    index = XdmfIndex(directory, prefix)
     for path in files:
-        fname = os.path.basename(path)  # the xdmf lives in the same folder: relative paths
-        with _open(path) as f:
-            sd = f["solver_data"].attrs
-            step = ET.SubElement(series, "Grid", Name=f"step_{int(sd['step'])}",
-                                 GridType="Collection", CollectionType="Spatial")
-            ET.SubElement(step, "Time", Value=repr(float(sd["t"])))
-            for g in f["arrays"].values():
-                _array_grid(step, fname, g)
-    ET.indent(root)
-    xdmf = os.path.join(directory, f"{prefix}.xdmf")
-    _write_text(xdmf, '<?xml version="1.0" ?>\n' + ET.tostring(root, encoding="unicode") + "\n")
-    return xdmf
+        if max_step is None or step_of(path) <= max_step:
+            index.add(path)
+    return index.write()
+
+
+def step_of(path):
+    """The step number in an output file's name ``<prefix>_<step>.h5``."""
+    return int(_SERIES.match(os.path.basename(path))["step"])
+
+
+# ------------------------------------------------------------------ folders
+_TMP = re.compile(r"^.+\.tmp-(?P<pid>\d+)$")
+RUN_FILES = ("info.json", "results.json", "history.json")
+
+
+def _pid_alive(pid):
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def remove_stray_temporaries(directory):
+    """Remove ``*.tmp-<pid>`` files left by writers that are no longer running."""
+    removed = []
+    for fname in sorted(os.listdir(directory)):
+        m = _TMP.match(fname)
+        if m and int(m["pid"]) != os.getpid() and not _pid_alive(int(m["pid"])):
+            with contextlib.suppress(FileNotFoundError):
+                os.remove(os.path.join(directory, fname))
+                removed.append(fname)
+    return removed
+
+
+def run_files(directory):
+    """Files of a sphgen run in a folder: output series, last-good states, XDMF, run JSON."""
+    if not os.path.isdir(directory):
+        return []
+    out = []
+    for fname in sorted(os.listdir(directory)):
+        if (_SERIES.match(fname) or fname.endswith("_last_good.h5") or fname.endswith(".xdmf")
+                or fname in RUN_FILES):
+            out.append(fname)
+    return out

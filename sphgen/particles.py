@@ -10,8 +10,10 @@ import difflib
 
 import numpy as np
 
+from .errors import SphgenError
 
-class PropertyError(ValueError):
+
+class PropertyError(SphgenError, ValueError):
     """A property is missing, misspelled, or has the wrong shape."""
 
 

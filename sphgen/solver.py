@@ -1,4 +1,10 @@
-"""The time loop: dt control, output schedule, progress bar, blow-up guard, restart."""
+"""The time loop: dt control, output schedule, progress bar, blow-up guard, restart.
+
+``Solver.run`` is the few steps a reader expects: prepare, then per step advance,
+check, after-step work (sorting, callbacks, output), then finish.  Output is always
+consistent on disk: every HDF5 file is complete or absent, and the XDMF index is
+rewritten (atomically) after each output, so ParaView opens a killed run.
+"""
 import math
 import os
 import time
@@ -6,10 +12,13 @@ import time
 import numpy as np
 
 from . import io
+from .errors import BlowUpError, RestartError, SphgenError
 
 
-class BlowUpError(RuntimeError):
-    """A non-finite value appeared; the message says where, the last good state is on disk."""
+class Interrupted(SphgenError):
+    """The user stopped the run (Ctrl-C); the last complete step is on disk."""
+
+    exit_code = 130
 
 
 class Solver:
@@ -18,11 +27,21 @@ class Solver:
     dt: fixed step, or the largest step when ``adaptive`` is on; adaptive steps use
     ``dt_props``: per-particle admissible steps written by equations (e.g. ``dt_cfl``),
     the step is ``cfl * min`` over all arrays that have them.
+
+    The guard (on by default) checks every step for non-finite values, a particle
+    faster than ``speed_limit``, a density outside ``density_bounds`` ({array: (lo,
+    hi)}) and a jump of the neighbour count (``neighbour_jump`` times the initial
+    pairs of a list); it stops the run naming step, array, property and particle, and
+    writes the last good state to ``<prefix>_last_good.h5``.
+
+    ``metadata`` is written into every output file's solver data (the application
+    stores the scene's identity there, which a restart checks).
     """
 
     def __init__(self, scene, integrator, dt, tf, *, adaptive=False, dt_props=("dt_cfl",), cfl=1.0,
                  max_steps=None, pfreq=100, output_at_times=(), outdir=None, prefix="sphgen",
-                 disable_output=False, progress=True, guard=True, speed_limit=None, sort_every=50):
+                 disable_output=False, progress=True, guard=True, speed_limit=None,
+                 density_bounds=None, neighbour_jump=4.0, sort_every=50, metadata=None):
         if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
             raise ValueError(f"time step dt={dt!r} must be a positive finite number")
         if not (math.isfinite(tf) and tf >= 0):
@@ -36,42 +55,49 @@ class Solver:
             raise ValueError(f"adaptive time step reads {', '.join(dt_props)}, which no array of the "
                              "scene computes: add an equation that writes it and list it in the "
                              "scene's outputs so the generator keeps it")
-        self.dt = float(dt)
-        self.tf = float(tf)
-        self.adaptive = adaptive
-        self.dt_props = tuple(dt_props)
-        self.cfl = cfl
+        self.dt, self.tf = float(dt), float(tf)
+        self.adaptive, self.dt_props, self.cfl = adaptive, tuple(dt_props), cfl
         self.max_steps = max_steps
         self.pfreq = pfreq
         self.output_at_times = sorted(output_at_times)
-        self.outdir = outdir
-        self.prefix = prefix
+        self.outdir, self.prefix = outdir, prefix
         self.disable_output = disable_output or outdir is None
         self.progress = progress
         self.guard = guard
         self.speed_limit = speed_limit
+        self.density_bounds = dict(density_bounds or {})
+        self.neighbour_jump = neighbour_jump
         # particles drift away from their memory neighbours; re-sorting keeps the
         # neighbour loops cache-friendly (carry a 'gid' property to track particles)
         self.sort_every = sort_every
+        self.metadata = dict(metadata or {})
         self.t = 0.0
         self.step = 0
         self.post_step_callbacks = []
+        self.output_callbacks = []
         self.wall_time = 0.0
         self.outputs_written = []
-        self._good = None
+        self.index = None
         self.restarted = False
+        self.log = []
+        self._good = None
+        self._pairs0 = {}
+        self._bar = None
 
     # ---------------------------------------------------------------- state
     def restart_from(self, path):
         """Load arrays and time from an output file written by a run of the same scene."""
-        data = io.load(path)
+        try:
+            data = io.load(path)
+        except (OSError, ValueError, KeyError) as e:
+            raise RestartError(f"--restart {path}: {e}") from None
         for pa in self.scene.arrays:
             if pa.name not in data["arrays"]:
-                raise ValueError(f"restart file {path} has no array '{pa.name}'")
+                raise RestartError(f"--restart {path} has no array '{pa.name}'")
             src = data["arrays"][pa.name]
             if src.n != pa.n:
-                raise ValueError(f"restart file {path}: array '{pa.name}' has {src.n} particles, "
-                                 f"the scene has {pa.n}")
+                raise RestartError(f"--restart {path}: array '{pa.name}' has {src.n} particles, "
+                                   f"the scene has {pa.n}")
             for name, arr in pa.data.items():
                 if name in src.data:
                     arr[:] = src.data[name]
@@ -95,12 +121,23 @@ class Solver:
         for pa in self.scene.arrays:
             for k, v in pa.data.items():
                 np.copyto(v, self._good[(pa.name, k)])
+        self.t, self.step = self._good_t, self._good_step
 
     def write_output(self, path=None):
+        """Write the state; a series file is added to the XDMF index, which is rewritten."""
         if self.outdir is None:
             return None
+        series = path is None
         path = path or os.path.join(self.outdir, f"{self.prefix}_{self.step:06d}.h5")
-        io.write(path, self.scene.arrays, {"t": self.t, "dt": self.dt, "step": self.step})
+        io.write(path, self.scene.arrays, {"t": self.t, "dt": self.dt, "step": self.step, **self.metadata})
+        if series:
+            self.outputs_written.append(path)
+            if self.index is None:
+                self.index = io.XdmfIndex(self.outdir, self.prefix)
+            self.index.add(path)
+            self.index.write()
+            for cb in self.output_callbacks:
+                cb(self, path)
         return path
 
     # ---------------------------------------------------------------- dt
@@ -131,91 +168,154 @@ class Solver:
     # ---------------------------------------------------------------- loop
     def run(self):
         """Step until tf (or max_steps). Returns the number of steps taken."""
-        if self.outdir:
-            os.makedirs(self.outdir, exist_ok=True)
+        self._prepare()
         t_start = time.perf_counter()
-        integ = self.integrator
+        try:
+            while not self._finished():
+                tprev = self.t
+                dt = self._advance()
+                self._check(dt)
+                self._after_step(tprev, dt)
+        except KeyboardInterrupt:
+            self._interrupted()
+        finally:
+            if self._bar is not None:
+                self._bar.close()
+            self.wall_time += time.perf_counter() - t_start
+        self._finish()
+        return self.step
+
+    def _prepare(self):
+        """Output folder and index, initial accelerations and output, guard snapshot."""
+        if not self.disable_output:
+            os.makedirs(self.outdir, exist_ok=True)
+            self.index = io.XdmfIndex(self.outdir, self.prefix)
+            for path in io.output_files(self.outdir, self.prefix):
+                if self.restarted and io.step_of(path) > self.step:
+                    os.remove(path)  # the future of the run being continued: recomputed
+                    self.log.append(f"removed {os.path.basename(path)} (after the restart step)")
+                elif self.restarted:
+                    self.index.add(path)
         if not self.restarted:
             # a restart file carries the accelerations of its step: recomputing them from
             # the end-of-step velocities would not reproduce the uninterrupted run
-            integ.initial_accelerations(self.t, self.dt)
+            self.integrator.initial_accelerations(self.t, self.dt)
         if not self.disable_output and self.step == 0:
-            self.outputs_written.append(self.write_output())
-        bar = None
+            self.write_output()
+        elif self.index is not None:
+            self.index.write()
         if self.progress:
             from tqdm import tqdm
-            bar = tqdm(total=self.tf, unit="t", bar_format="{l_bar}{bar}| t={n:.4g}/{total:.4g} "
-                       "[{elapsed}<{remaining}{postfix}]", leave=False, mininterval=0.5)
-            bar.update(self.t)
+            self._bar = tqdm(total=self.tf, unit="t", bar_format="{l_bar}{bar}| t={n:.4g}/{total:.4g} "
+                             "[{elapsed}<{remaining}{postfix}]", leave=False, mininterval=0.5)
+            self._bar.update(self.t)
         if self.guard:
+            self._pairs0 = {(d, s): n for d, s, n, _, _ in self.scene.nnps.busiest()}
             self._snapshot()
-        eps = 1e-12 * max(1.0, self.tf)
-        try:
-            while self.t < self.tf - eps:
-                if self.max_steps is not None and self.step >= self.max_steps:
-                    break
-                dt = self.next_dt()
-                tprev = self.t
-                try:
-                    integ.one_timestep(self.t, dt)
-                except ValueError:
-                    # e.g. the neighbour search met a non-finite position mid-step
-                    bad = self.scene.check_finite() if self.guard else None
-                    if bad is None:
-                        raise
-                    self.step += 1
-                    self.t += dt
-                    self._blow_up(bad, dt)
-                self.t += dt
-                self.step += 1
-                self.last_dt = dt
-                if self.guard:
-                    bad = self.scene.check_finite()
-                    if bad is not None:
-                        self._blow_up(bad, dt)
-                    if self.speed_limit is not None:
-                        self._check_speed(dt)
-                    self._snapshot()
-                if self.sort_every and self.step % self.sort_every == 0:
-                    self.scene.sort()
-                for cb in self.post_step_callbacks:
-                    cb(self)
-                if self._should_output(tprev):
-                    self.outputs_written.append(self.write_output())
-                if bar is not None:
-                    bar.update(self.t - tprev)
-                    if self.step % 50 == 0:
-                        bar.set_postfix_str(f"step={self.step}, dt={dt:.3g}", refresh=False)
-        finally:
-            if bar is not None:
-                bar.close()
-            self.wall_time += time.perf_counter() - t_start
-        if not self.disable_output and (not self.outputs_written or
-                                        not self.outputs_written[-1].endswith(f"_{self.step:06d}.h5")):
-            self.outputs_written.append(self.write_output())
-        if not self.disable_output:
-            io.write_xdmf(self.outdir, self.prefix)
-        return self.step
 
-    def _check_speed(self, dt):
+    def _finished(self):
+        if self.max_steps is not None and self.step >= self.max_steps:
+            return True
+        return self.t >= self.tf - 1e-12 * max(1.0, self.tf)
+
+    def _advance(self):
+        """One integrator step; a neighbour search that meets a non-finite position is a blow-up."""
+        dt = self.next_dt()
+        try:
+            self.integrator.one_timestep(self.t, dt)
+        except ValueError:
+            bad = self.scene.check_finite() if self.guard else None
+            if bad is None:
+                raise
+            self.t, self.step = self.t + dt, self.step + 1
+            self._blow_up(dt, "non-finite {}.{} at particle {}".format(*bad))
+        self.t += dt
+        self.step += 1
+        self.last_dt = dt
+        return dt
+
+    def _check(self, dt):
+        """The guard's checks (each cheap, every step); a good state is snapshotted."""
+        if not self.guard:
+            return
+        bad = self.scene.check_finite()
+        if bad is not None:
+            self._blow_up(dt, "non-finite {}.{} at particle {}".format(*bad))
+        for what in (self._check_speed(), self._check_density(), self._check_neighbours()):
+            if what:
+                self._blow_up(dt, what)
+        self._snapshot()
+
+    def _after_step(self, tprev, dt):
+        if self.sort_every and self.step % self.sort_every == 0:
+            self.scene.sort()
+        for cb in self.post_step_callbacks:
+            cb(self)
+        if self._should_output(tprev):
+            self.write_output()
+        if self._bar is not None:
+            self._bar.update(self.t - tprev)
+            if self.step % 50 == 0:
+                self._bar.set_postfix_str(f"step={self.step}, dt={dt:.3g}", refresh=False)
+
+    def _finish(self):
+        """The final state is always in the series."""
+        if self.disable_output:
+            return
+        if not self.outputs_written or not self.outputs_written[-1].endswith(f"_{self.step:06d}.h5"):
+            self.write_output()
+
+    # ---------------------------------------------------------------- guard
+    def _check_speed(self):
         """A particle faster than the scheme's limit (e.g. Mach 1 for weak compressibility)."""
+        if self.speed_limit is None:
+            return None
         for name, speed2, i in self.scene.max_speed2():
             if speed2 > self.speed_limit ** 2:
-                what = (f"speed {np.sqrt(speed2):.3g} of {name} particle {i} exceeds the "
-                        f"scheme's limit {self.speed_limit:.3g}")
-                self._blow_up(None, dt, what)
+                comps = ", ".join(("u", "v", "w")[:self.scene.dim])
+                return (f"speed |({comps})| = {np.sqrt(speed2):.3g} of {name} particle {i} is above "
+                        f"the scheme's limit {self.speed_limit:.3g}")
+        return None
 
-    def _blow_up(self, bad, dt, what=None):
-        if what is None:
-            arr, prop, idx = bad
-            what = f"non-finite {arr}.{prop} at particle {idx}"
+    def _check_density(self):
+        for name, (lo, hi) in self.density_bounds.items():
+            rho = self.scene.by_name[name].data.get("rho")
+            if rho is None or rho.size == 0:
+                continue
+            i, j = int(np.argmin(rho)), int(np.argmax(rho))
+            if rho[i] < lo:
+                return f"density {name}.rho = {rho[i]:.4g} at particle {i} is below the bound {lo:.4g}"
+            if rho[j] > hi:
+                return f"density {name}.rho = {rho[j]:.4g} at particle {j} is above the bound {hi:.4g}"
+        return None
+
+    def _check_neighbours(self):
+        for d, s, pairs, i, count in self.scene.nnps.busiest():
+            start = self._pairs0.get((d, s))
+            if start and pairs > self.neighbour_jump * start:
+                return (f"neighbour pairs {d}<-{s} jumped from {start} to {pairs} (particle {i} of "
+                        f"{d} has {count} neighbours): particles are clumping")
+        return None
+
+    def _blow_up(self, dt, what):
         where = f"{what}, step {self.step} (t={self.t:.6g}, dt={dt:.3g})"
-        saved = ""
-        if self._good is not None:
-            # the arrays go back to the last good state, for post-mortem in memory and on disk
-            self._restore_snapshot()
-            self.t, self.step = self._good_t, self._good_step
-            if self.outdir is not None:
-                path = self.write_output(os.path.join(self.outdir, f"{self.prefix}_last_good.h5"))
-                saved = f"; last good state (step {self.step}, t={self.t:.6g}) written to {path}"
-        raise BlowUpError(where + saved)
+        raise BlowUpError(where + self._save_last_good())
+
+    def _save_last_good(self):
+        """Arrays back to the last good state, in memory and on disk; the saying of where."""
+        if self._good is None:
+            return ""
+        self._restore_snapshot()
+        if self.outdir is None:
+            return ""
+        path = self.write_output(os.path.join(self.outdir, f"{self.prefix}_last_good.h5"))
+        return f"; last good state (step {self.step}, t={self.t:.6g}) written to {path}"
+
+    def _interrupted(self):
+        """Ctrl-C: the last complete step goes into the series so ``--restart`` continues it."""
+        if self._good is None or self.disable_output:
+            raise Interrupted(f"interrupted at step {self.step} (t={self.t:.6g}); nothing written")
+        self._restore_snapshot()
+        path = self.write_output()
+        raise Interrupted(f"interrupted at step {self.step} (t={self.t:.6g}); that state is in {path}: "
+                          f"continue with --restart {path}")

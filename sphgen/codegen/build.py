@@ -18,8 +18,10 @@ from contextlib import redirect_stderr, redirect_stdout
 
 import numpy
 
+from ..errors import SphgenError
 
-class CompileError(RuntimeError):
+
+class CompileError(SphgenError, RuntimeError):
     """The generated code did not compile; the message names the equation and line."""
 
 

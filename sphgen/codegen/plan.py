@@ -6,6 +6,7 @@ keeps, the Python evaluator runs exactly what it keeps, and ``--show-plan`` prin
 import difflib
 
 from ..equation import Equation, Group, PAIR_METHODS
+from ..errors import SphgenError
 from .translate import TranslationError, specialise
 
 POSITION = ("x", "y", "z")
@@ -25,7 +26,7 @@ def folded_switches(obj):
     return out
 
 
-class SceneError(ValueError):
+class SceneError(SphgenError, ValueError):
     """A scene is inconsistent: missing property, bad array name, race, ..."""
 
 

@@ -19,9 +19,10 @@ from compyle.cython_generator import CythonGenerator
 from compyle.types import KnownType
 
 from ..equation import PAIR_SYMBOLS, VECTOR_SYMBOLS
+from ..errors import SphgenError
 
 
-class TranslationError(Exception):
+class TranslationError(SphgenError):
     """A method uses Python the generator cannot translate."""
 
 

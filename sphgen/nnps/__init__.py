@@ -279,6 +279,17 @@ class NeighbourSearch:
         self.n_cells = tuple(g_n)
 
     # ------------------------------------------------------------ queries
+    def busiest(self):
+        """(dest, src, total pairs, particle with most neighbours, its count) over the lists
+        built since the last update, one tuple per (dest, src); for the blow-up guard."""
+        out = []
+        for (d, s), (off, _) in self._cache.items():
+            if len(off) > 1:
+                counts = np.diff(off)
+                i = int(np.argmax(counts))
+                out.append((d, s, int(off[-1]), i, int(counts[i])))
+        return out
+
     def neighbours(self, dest, src):
         """``(offsets, nbrs)``: int32 CSR lists; ``nbrs[offsets[i]:offsets[i+1]]`` are
         the indices j of ``src`` (ascending) with ``|r_ij| < k*max(h_i, h_j)``.
