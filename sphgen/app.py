@@ -22,32 +22,33 @@ from .scene import Scene
 from .solver import Solver
 
 
-def _positive_float(s):
-    v = float(s)
-    if not (math.isfinite(v) and v > 0):
-        raise argparse.ArgumentTypeError(f"must be a positive finite number, got {s}")
+def _number(s, kind, ok, what):
+    try:
+        v = kind(s)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be {what}, got {s!r}") from None
+    if not ok(v):
+        raise argparse.ArgumentTypeError(f"must be {what}, got {s}")
     return v
+
+
+def _positive_float(s):
+    return _number(s, float, lambda v: math.isfinite(v) and v > 0, "a positive finite number")
 
 
 def _nonneg_float(s):
-    v = float(s)
-    if not (math.isfinite(v) and v >= 0):
-        raise argparse.ArgumentTypeError(f"must be a non-negative finite number, got {s}")
-    return v
+    return _number(s, float, lambda v: math.isfinite(v) and v >= 0, "a non-negative finite number")
 
 
 def _positive_int(s):
-    v = int(s)
-    if v < 1:
-        raise argparse.ArgumentTypeError(f"must be a positive integer, got {s}")
-    return v
+    return _number(s, int, lambda v: v >= 1, "a positive integer")
 
 
 class _Parser(argparse.ArgumentParser):
     """argparse whose mistakes are an InputError (one line), not a usage dump and exit."""
 
     def error(self, message):
-        raise InputError(f"{self.prog}: {message} (see --help)")
+        raise InputError(f"{message} (see {self.prog} --help)")
 
 
 class Application:

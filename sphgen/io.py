@@ -310,3 +310,27 @@ def run_files(directory):
                 or fname in RUN_FILES):
             out.append(fname)
     return out
+
+
+def verify_xdmf(path):
+    """Open every dataset an XDMF index names, as a reader would; returns (steps, datasets).
+
+    Raises ValueError naming the first entry that does not resolve or has the wrong shape.
+    """
+    directory = os.path.dirname(os.path.abspath(path))
+    root = ET.parse(path).getroot()
+    steps = root.findall("./Domain/Grid/Grid")
+    n = 0
+    for item in root.iter("DataItem"):
+        if item.get("Format") != "HDF":
+            continue
+        fname, dsname = item.text.strip().split(":", 1)
+        want = tuple(int(d) for d in item.get("Dimensions").split())
+        with h5py.File(os.path.join(directory, fname), "r") as f:
+            if dsname not in f:
+                raise ValueError(f"{path}: {fname} has no dataset {dsname}")
+            if f[dsname].shape != want:
+                raise ValueError(f"{path}: {fname}:{dsname} has shape {f[dsname].shape}, index says {want}")
+            f[dsname][()]
+        n += 1
+    return len(steps), n

@@ -57,7 +57,7 @@ def read_restart(path):
     except FileNotFoundError:
         raise RestartError(f"--restart {path}: no such file") from None
     except (OSError, ValueError, KeyError) as e:
-        raise RestartError(f"--restart {path}: {e}") from None
+        raise RestartError(f"--restart: {e}") from None
 
 
 def _flatten(d, prefix=""):

@@ -129,6 +129,11 @@ class Solver:
             return None
         series = path is None
         path = path or os.path.join(self.outdir, f"{self.prefix}_{self.step:06d}.h5")
+        if series:
+            # time series first: a kill between the two leaves them ahead of the output
+            # file, and a restart keeps only the rows up to its time
+            for cb in self.output_callbacks:
+                cb(self, path)
         io.write(path, self.scene.arrays, {"t": self.t, "dt": self.dt, "step": self.step, **self.metadata})
         if series:
             self.outputs_written.append(path)
@@ -136,8 +141,6 @@ class Solver:
                 self.index = io.XdmfIndex(self.outdir, self.prefix)
             self.index.add(path)
             self.index.write()
-            for cb in self.output_callbacks:
-                cb(self, path)
         return path
 
     # ---------------------------------------------------------------- dt

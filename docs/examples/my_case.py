@@ -20,6 +20,7 @@ import numpy as np
 from sphgen import io
 from sphgen.app import Application
 from sphgen.equation import Equation, Group
+from sphgen.errors import InputError
 from sphgen.integrators import Integrator, IntegratorStep
 from sphgen.nnps import Domain
 from sphgen.particles import ParticleArray
@@ -119,9 +120,9 @@ class MyCase(Application):
 
     def consume_user_options(self, o):
         if o.nx < 8:
-            raise SystemExit(f"--nx must be at least 8, got {o.nx}")
+            raise InputError(f"--nx must be at least 8, got {o.nx}")
         if not (np.isfinite(o.D) and o.D > 0 and np.isfinite(o.kappa) and o.kappa >= 0):
-            raise SystemExit("--D must be > 0 and --kappa >= 0")
+            raise InputError("--D must be > 0 and --kappa >= 0")
         self.dx = 1.0 / o.nx
         self.h = self.dx
 

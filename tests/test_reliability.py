@@ -1,0 +1,168 @@
+"""Runs that never lose data and answer a user mistake with one clear line.
+
+The full tables (32 bad inputs, 10 kills) are in benchmarks/bad_input.py and
+benchmarks/kill_test.py; these tests check each mechanism once.
+"""
+import hashlib
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+from sphgen import io
+from sphgen.app import load_application, main
+from sphgen.equation import ParameterError
+from sphgen.errors import BlowUpError, RestartError
+
+TG = ["run", "taylor_green", "--no-progress", "--nx", "16", "--no-openmp"]
+
+
+def digest(folder):
+    return {f: hashlib.sha1(open(os.path.join(folder, f), "rb").read()).hexdigest()
+            for f in sorted(os.listdir(folder))}
+
+
+def refused(args, capsys):
+    """Run sphgen with ``args``; it must exit non-zero with one line and no traceback."""
+    with pytest.raises(SystemExit) as e:
+        main(TG + args)
+    err = capsys.readouterr().err.strip()
+    assert e.value.code not in (0, None)
+    assert "\n" not in err and "Traceback" not in err and 0 < len(err) <= 300, err
+    return err
+
+
+@pytest.fixture(scope="module")
+def finished(tmp_path_factory):
+    """A finished run of 15 steps with outputs every 5."""
+    out = tmp_path_factory.mktemp("ref") / "run"
+    main(TG + ["--tf", "0.02", "--pfreq", "5", "-d", str(out)])
+    return out
+
+
+def test_folder_with_another_run_is_refused_and_untouched(finished, capsys):
+    before = digest(finished)
+    err = refused(["--tf", "0.01", "-d", str(finished)], capsys)
+    assert "already holds a run" in err and "--overwrite" in err
+    assert digest(finished) == before
+
+
+@pytest.mark.parametrize("args,match", [
+    (["--re", "1000"], "options.re = 100.0 there, 1000.0 now"),
+    (["--tf", "0.01"], "at or past --tf 0.01"),
+])
+def test_restart_of_another_scene_or_past_tf_is_refused(finished, tmp_path, capsys, args, match):
+    mid = os.path.join(finished, "taylor_green_000005.h5")
+    last = io.output_files(finished)[-1]
+    before = digest(finished)
+    err = refused(args + ["--restart", last if "--tf" in args else mid, "-d", str(tmp_path / "r")], capsys)
+    assert match in err
+    assert digest(finished) == before and not os.path.exists(tmp_path / "r")
+
+
+def test_debug_shows_the_exception(finished, tmp_path):
+    with pytest.raises(RestartError):
+        main(TG + ["--re", "1000", "--restart", io.output_files(finished)[0], "-d", str(tmp_path / "x"),
+                   "--debug"])
+
+
+def test_overwrite_clears_the_other_run_and_dead_temporaries(finished, tmp_path):
+    out = tmp_path / "again"
+    subprocess.run(["cp", "-r", str(finished), str(out)], check=True)
+    (out / "taylor_green_000099.h5.tmp-999999").write_bytes(b"half")
+    (out / "my_notes.txt").write_text("keep me")
+    main(TG + ["--tf", "0.01", "--pfreq", "5", "-d", str(out), "--overwrite"])
+    names = os.listdir(out)
+    assert "my_notes.txt" in names and not any(".tmp-" in n for n in names)
+    assert json.load(open(out / "info.json"))["completed"]
+    assert io.verify_xdmf(out / "taylor_green.xdmf")[0] == len(io.output_files(out))
+
+
+def test_unknown_equation_keyword_has_a_hint():
+    from sphgen.equations.edac import EDACPressureRate
+    with pytest.raises(ParameterError, match="unknown parameter 'c00'; did you mean 'c0'"):
+        EDACPressureRate("fluid", ["fluid"], c00=3.0, nu_edac=0.1)
+
+
+def test_unstable_run_stops_at_the_first_bad_step_with_last_good_state(tmp_path):
+    """Guard off: find the first step with a value out of bounds; guard on: it stops there."""
+    App = load_application("taylor_green")
+    args = ["--nx", "16", "--dt", "0.02", "--allow-unstable", "--tf", "1", "--no-progress",
+            "--no-openmp", "--disable-output", "--debug"]
+    first = {}
+
+    class Unguarded(App):
+        def _solver(self, integrator, dt):
+            solver = super()._solver(integrator, dt)
+            solver.guard = False
+            return solver
+
+        def post_step(self, solver):
+            f = solver.scene.by_name["fluid"]
+            lo, hi = self.scheme.density_bounds()["fluid"]
+            finite = all(np.all(np.isfinite(a)) for a in f.data.values())
+            if not finite or f.rho.min() < lo or f.rho.max() > hi or \
+                    np.hypot(f.u, f.v).max() > self.scheme.speed_limit:
+                first["step"] = solver.step
+                raise KeyboardInterrupt
+
+    with pytest.raises(Exception):
+        Unguarded("taylor_green").run(args + ["-d", str(tmp_path / "a")])
+    with pytest.raises(BlowUpError) as e:
+        App("taylor_green").run(args + ["-d", str(tmp_path / "b")])
+    msg = str(e.value)
+    stop = int(msg.split(", step ")[1].split()[0])
+    assert "particle" in msg and "fluid" in msg
+    assert first and stop - first["step"] <= 3, (stop, first)
+    good = io.load(str(tmp_path / "b" / "taylor_green_last_good.h5"))
+    assert good["solver_data"]["step"] == stop - 1
+    assert all(np.all(np.isfinite(a)) for a in good["arrays"]["fluid"].data.values())
+
+
+def test_sigkill_leaves_readable_files_and_restart_is_bit_for_bit(tmp_path):
+    exe = os.path.join(os.path.dirname(sys.executable), "sphgen")
+    case = ["--nx", "16", "--tf", "0.06", "--pfreq", "2", "--no-progress", "--no-openmp"]
+    ref, out = tmp_path / "ref", tmp_path / "killed"
+    subprocess.run([exe, "run", "taylor_green", *case, "-d", str(ref)], check=True, capture_output=True)
+    p = subprocess.Popen([exe, "run", "taylor_green", *case, "-d", str(out)],
+                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    while p.poll() is None and len(io.output_files(out) if out.exists() else []) < 5:
+        time.sleep(0.005)
+    p.send_signal(signal.SIGKILL)
+    p.wait()
+    files = io.output_files(out)
+    assert files, "killed before the first output: nothing to check"
+    for f in files:
+        io.load(f)
+    assert io.verify_xdmf(out / "taylor_green.xdmf")[0] in (len(files), len(files) - 1)
+    subprocess.run([exe, "run", "taylor_green", *case, "-d", str(out), "--restart", files[-1]],
+                   check=True, capture_output=True)
+    assert not [n for n in os.listdir(out) if ".tmp-" in n]
+    a, b = io.load(io.output_files(ref)[-1]), io.load(io.output_files(out)[-1])
+    assert a["solver_data"]["step"] == b["solver_data"]["step"]
+    for prop in ("x", "y", "u", "v", "p", "rho"):
+        np.testing.assert_array_equal(a["arrays"]["fluid"].data[prop], b["arrays"]["fluid"].data[prop])
+    for name in ("history.json", "results.json"):
+        assert json.load(open(ref / name)) == json.load(open(out / name)), name
+    info = json.load(open(out / "info.json"))
+    assert info["completed"] is True and info["restarts"][-1]["step"] == io.step_of(files[-1])
+
+
+def test_ctrl_c_writes_the_last_complete_step(tmp_path):
+    app = load_application("taylor_green")()
+
+    def stop(solver):
+        if solver.step == 7:
+            raise KeyboardInterrupt
+    app.post_step = stop
+    with pytest.raises(SystemExit) as e:
+        app.run(["--nx", "16", "--tf", "0.02", "--no-progress", "--no-openmp", "-d", str(tmp_path)])
+    assert e.value.code == 130
+    last = io.output_files(tmp_path)[-1]
+    assert io.load(last)["solver_data"]["step"] == 7   # the last complete step
+    assert json.load(open(tmp_path / "info.json"))["completed"] is False
