@@ -18,6 +18,9 @@ from ..equations.momentum import (ArtificialViscosity, AveragePressure, LaminarV
                                  PressureGradient)
 from ..equations.transport import (BackgroundPressureAcceleration, SunShiftingAcceleration,
                                   TransportStress)
+from ..equations.walls import (WallArtificialViscosity, WallDensity, WallEDACPressureRate,
+                               WallGhostVelocity, WallPressure, WallViscosity)
+from ..equations.wcsph import BodyForce
 
 PSTS = ("none", "sun2019", "tvf")
 
@@ -66,12 +69,25 @@ class EDACStep(IntegratorStep):
 
 
 class EDACScheme(Scheme):
-    """EDAC for fluids without walls (periodic or open), seed 002 uncorrected baseline."""
+    """EDAC, seed 002 uncorrected baseline, with optional Adami walls and body force.
+
+    Walls (``walls``: array names, fixed particles with ``m``, ``h``, ``rho``): every
+    evaluation of the momentum equation first gives them the pressure extrapolated from
+    the fluid with the body-force term (Adami, Hu & Adams 2012 eq. 27), the density of the
+    linear equation of state rho0 + p/c0^2 and the ghost velocity (eqs. 22-23; no slip, or
+    free slip with ``slip=True``).  Walls enter the summation density, the pressure
+    gradient, the EDAC pressure equation (with the wall's prescribed velocity) and the
+    shifting terms; viscosity and artificial viscosity use the ghost / prescribed wall
+    velocity.  ``moving_walls`` names the walls with a prescribed velocity ``uw, vw, ww``.
+    ``gx, gy, gz`` is a body force per unit mass, ramped in over ``tdamp`` if > 0.
+    Without walls and body force the equations are exactly those of the periodic scheme.
+    """
 
     output_props = ("x", "y", "z", "u", "v", "w", "p", "rho", "m", "h")
 
     def __init__(self, fluids, dim, rho0, c0, nu, h, dx, umax=1.0, pst="none", alpha=0.0,
-                 alpha_edac=0.5, mach=None, pb=None, bql=True, kernel="quintic"):
+                 alpha_edac=0.5, mach=None, pb=None, bql=True, kernel="quintic", walls=(),
+                 gx=0.0, gy=0.0, gz=0.0, slip=False, moving_walls=(), tdamp=0.0):
         if pst not in PSTS:
             raise ValueError(f"pst must be one of {', '.join(PSTS)}; got {pst!r}")
         for name, v in (("rho0", rho0), ("c0", c0), ("h", h), ("dx", dx), ("umax", umax)):
@@ -80,6 +96,10 @@ class EDACScheme(Scheme):
         if not nu >= 0:
             raise ValueError(f"EDACScheme: nu={nu!r} must be >= 0")
         self.fluids, self.dim = list(fluids), dim
+        self.walls, self.moving_walls = list(walls), list(moving_walls)
+        if any(w not in self.walls for w in self.moving_walls):
+            raise ValueError(f"EDACScheme: moving_walls {self.moving_walls} must be among walls {self.walls}")
+        self.gx, self.gy, self.gz, self.slip, self.tdamp = gx, gy, gz, bool(slip), tdamp
         self.rho0, self.c0, self.nu, self.h, self.dx, self.umax = rho0, c0, nu, h, dx, umax
         self.pst, self.alpha, self.alpha_edac = pst, alpha, alpha_edac
         self.mach = umax / c0 if mach is None else mach
@@ -97,31 +117,57 @@ class EDACScheme(Scheme):
         for pa in arrays:
             for p in ("p", "ap", "pavg", "nnbr", "au", "av", "aw", "uhat", "vhat", "what", "auhat", "avhat", "awhat", "omega"):
                 pa.add_property(p)
+            if pa.name in self.walls:
+                for p in ("wij", "ug", "vg", "wg", "uw", "vw", "ww", "auw", "avw", "aww"):
+                    if not pa.has(p):
+                        pa.add_property(p)
+                if not pa.has("normal"):
+                    pa.add_property("normal", stride=3)
 
     def get_equations(self):
         f = self.fluids
         nu_edac = self.alpha_edac * self.h * self.c0 / 8.0  # seed 002 eq. 24
         shift = self.pst != "none"
-        pressure = [Group([EDACPressureRate(d, f, c0=self.c0, nu_edac=nu_edac) for d in f])]
+        w, fw = self.walls, self.fluids + self.walls
+        pressure = []
+        for d in f:
+            pressure.append(EDACPressureRate(d, f, c0=self.c0, nu_edac=nu_edac))
+            pressure += [WallEDACPressureRate(d, [s], c0=self.c0, nu_edac=nu_edac,
+                                              moving=s in self.moving_walls) for s in w]
+        pressure = [Group(pressure)]
         momentum = []
         for d in f:
-            momentum += [PressureGradient(d, f, bql=self.bql),
+            momentum += [PressureGradient(d, fw, bql=self.bql),
                          LaminarViscosity(d, f, nu=self.nu),
                          ArtificialViscosity(d, f, alpha=self.alpha, c0=self.c0)]
+            if w:
+                momentum.append(WallViscosity(d, w, nu=self.nu))
+                momentum += [WallArtificialViscosity(d, [s], alpha=self.alpha, c0=self.c0,
+                                                     moving=s in self.moving_walls) for s in w]
             if shift:
                 momentum.append(TransportStress(d, f))
             if self.pst == "sun2019":
                 wdx = self.kernel.w(self.dx, self.h)
-                momentum.append(SunShiftingAcceleration(d, f, mach=self.mach, c0=self.c0, wdx=wdx))
+                momentum.append(SunShiftingAcceleration(d, fw, mach=self.mach, c0=self.c0, wdx=wdx))
             elif self.pst == "tvf":
-                momentum.append(BackgroundPressureAcceleration(d, f, pb=self.pb))
+                momentum.append(BackgroundPressureAcceleration(d, fw, pb=self.pb))
+            if self.gx or self.gy or self.gz:
+                momentum.append(BodyForce(d, gx=self.gx, gy=self.gy, gz=self.gz, tdamp=self.tdamp))
             if self.dim == 2:
                 momentum.append(Vorticity2D(d, f))
-        density = [SummationDensity(d, f) for d in f]
+        density = [SummationDensity(d, fw) for d in f]
         if self.bql:
             density += [AveragePressure(d, f) for d in f]
         density = Group(density)
-        return [pressure, [density, Group(momentum)]]
+        if not w:
+            return [pressure, [density, Group(momentum)]]
+        g = dict(gx=self.gx, gy=self.gy, gz=self.gz)
+        walls = []
+        for d in w:
+            walls += [WallPressure(d, f, **g),
+                      WallDensity(d, eos="linear", rho0=self.rho0, c0=self.c0),
+                      WallGhostVelocity(d, f, slip=self.slip, moving=d in self.moving_walls, dim=self.dim)]
+        return [pressure, [density, Group(walls), Group(momentum)]]
 
     def get_integrator(self):
         step = EDACStep(self.dim, self.pst != "none")
