@@ -13,6 +13,7 @@ import numpy as np
 
 from . import io
 from .errors import BlowUpError, RestartError, SphgenError
+from .threads import ThreadTuner
 
 
 class Interrupted(SphgenError):
@@ -41,7 +42,8 @@ class Solver:
     def __init__(self, scene, integrator, dt, tf, *, adaptive=False, dt_props=("dt_cfl",), cfl=1.0,
                  max_steps=None, pfreq=100, output_at_times=(), outdir=None, prefix="sphgen",
                  disable_output=False, progress=True, guard=True, speed_limit=None,
-                 density_bounds=None, neighbour_jump=4.0, sort_every=50, metadata=None):
+                 density_bounds=None, neighbour_jump=4.0, sort_every=50, metadata=None,
+                 tune_threads=None):
         if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
             raise ValueError(f"time step dt={dt!r} must be a positive finite number")
         if not (math.isfinite(tf) and tf >= 0):
@@ -71,6 +73,11 @@ class Solver:
         # neighbour loops cache-friendly (carry a 'gid' property to track particles)
         self.sort_every = sort_every
         self.metadata = dict(metadata or {})
+        # the thread count is an upper bound: under load one thread may be faster
+        # (SPHGEN_TUNE_THREADS=0 keeps the count fixed, for benchmarks)
+        if tune_threads is None:
+            tune_threads = os.environ.get("SPHGEN_TUNE_THREADS", "1") != "0"
+        self.tuner = ThreadTuner(scene) if tune_threads else None
         self.t = 0.0
         self.step = 0
         self.post_step_callbacks = []
@@ -224,6 +231,7 @@ class Solver:
     def _advance(self):
         """One integrator step; a neighbour search that meets a non-finite position is a blow-up."""
         dt = self.next_dt()
+        start = time.perf_counter()
         try:
             self.integrator.one_timestep(self.t, dt)
         except ValueError:
@@ -235,6 +243,8 @@ class Solver:
         self.t += dt
         self.step += 1
         self.last_dt = dt
+        if self.tuner is not None:
+            self.tuner.record(self.step, time.perf_counter() - start)
         return dt
 
     def _check(self, dt):

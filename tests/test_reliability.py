@@ -166,3 +166,28 @@ def test_ctrl_c_writes_the_last_complete_step(tmp_path):
     last = io.output_files(tmp_path)[-1]
     assert io.load(last)["solver_data"]["step"] == 7   # the last complete step
     assert json.load(open(tmp_path / "info.json"))["completed"] is False
+
+
+def test_thread_tuner_drops_to_one_thread_under_load_and_returns():
+    from sphgen.threads import ThreadTuner
+
+    class FakeScene:
+        threads = 2
+
+        def set_threads(self, n):
+            self.threads = n
+
+    scene = FakeScene()
+    tuner = ThreadTuner(scene, trial=3, first=4)
+    cost = {2: 4.0, 1: 1.0}          # loaded machine: 2 threads 4x slower than one
+    for step in range(1, 40):
+        tuner.record(step, cost[scene.threads])
+    assert scene.threads == 1 and tuner.choices[0][1] == 1
+    cost = {2: 0.55, 1: 1.0}         # load gone: 2 threads 1.8x faster
+    for step in range(40, 200):
+        tuner.record(step, cost[scene.threads])
+    assert scene.threads == 2 and tuner.choices[-1][1] == 2
+    n_trials = len(tuner.choices)
+    for step in range(200, 2000):    # steady: trials become rare (intervals double)
+        tuner.record(step, cost[scene.threads])
+    assert tuner.every > 200 and len(tuner.choices) == n_trials
