@@ -107,6 +107,8 @@ class Application:
         g = p.add_argument_group("run")
         g.add_argument("--tf", type=_nonneg_float, help="final time (default %(default)s)")
         g.add_argument("--dt", type=_positive_float, default=None, help="time step (default: the scheme's)")
+        g.add_argument("--dt-factor", type=_positive_float, default=1.0,
+                       help="multiply the time step by this (default 1; above 1 needs --allow-unstable)")
         g.add_argument("--max-steps", type=_positive_int, default=None, help="stop after this many steps")
         g.add_argument("--openmp", dest="openmp", action="store_true", default=True,
                        help="use all cores (default)")
@@ -160,7 +162,7 @@ class Application:
         arrays = self.create_particles()
         self.scheme = self.create_scheme()
         self.scheme.setup_properties(arrays)
-        dt = opts.dt or self.scheme.get_timestep()
+        dt = (opts.dt or self.scheme.get_timestep()) * opts.dt_factor
         for warning in self.scheme.check_stability(dt, opts.allow_unstable):
             print(f"sphgen: warning: {warning}", file=sys.stderr)
         self.signature = self._signature(arrays)
@@ -307,15 +309,27 @@ def load_application(name):
 def main(argv=None):
     argv = sys.argv[1:] if argv is None else argv
     if not argv or argv[0] in ("-h", "--help"):
-        print("usage: sphgen run NAME [options] | sphgen list\n"
-              "  run NAME   run an application (sphgen run NAME --help for its options)\n"
-              "  list       list the applications")
+        print("usage: sphgen run NAME [options] | sphgen precision NAME ... | sphgen stress NAME ... "
+              "| sphgen list\n"
+              "  run NAME        run an application (sphgen run NAME --help for its options)\n"
+              "  precision NAME  error against run time over resolutions (sphgen precision --help)\n"
+              "  stress NAME     perturbed runs at several dt factors (sphgen stress --help)\n"
+              "  list            list the applications")
         return 0
     if argv[0] == "list":
         print("\n".join(list_applications()))
         return 0
+    if argv[0] in ("precision", "stress"):
+        from . import studies
+        try:
+            return studies.main(argv[0], argv[1:])
+        except SphgenError as e:
+            if debug_requested(argv):
+                raise
+            raise SystemExit(f"sphgen: {one_line(e)}") from None
     if argv[0] != "run" or len(argv) < 2:
-        raise SystemExit(f"sphgen: unknown command {' '.join(argv)!r}; try 'sphgen run NAME' or 'sphgen list'")
+        raise SystemExit(f"sphgen: unknown command {' '.join(argv)!r}; try 'sphgen run NAME', "
+                         "'sphgen precision NAME', 'sphgen stress NAME' or 'sphgen list'")
     load_application(argv[1])().run(argv[2:])
     return 0
 

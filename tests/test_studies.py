@@ -1,0 +1,47 @@
+"""`sphgen precision` and `sphgen stress`: sweep parsing, tables and plots of real runs."""
+import json
+import os
+
+import pytest
+
+from sphgen.app import main
+from sphgen.errors import InputError
+from sphgen.studies import cases, split_sweep
+
+
+def test_options_with_several_values_are_sweep_axes():
+    axes, fixed = split_sweep(["--nx", "25", "50", "--tf", "0.1", "--scheme", "a", "b", "--no-openmp",
+                               "--shift", "-1"])
+    assert axes == [("--nx", ["25", "50"]), ("--scheme", ["a", "b"])]
+    assert fixed == ["--tf", "0.1", "--no-openmp", "--shift", "-1"]
+    assert [label for label, _ in cases(axes)] == ["nx25_schemea", "nx25_schemeb", "nx50_schemea",
+                                                   "nx50_schemeb"]
+    assert cases([]) == [("run", [])]
+    with pytest.raises(InputError):
+        split_sweep(["25", "--nx"])
+
+
+def test_precision_and_stress_write_tables_and_plots(tmp_path, capsys):
+    d = tmp_path / "prec"
+    assert main(["precision", "taylor_green", "--nx", "12", "16", "--tf", "0.02", "--no-openmp",
+                 "-d", str(d)]) == 0
+    data = json.load(open(d / "precision.json"))
+    assert data["error_key"] == "l1_error_mean" and len(data["runs"]) == 2
+    assert all(r["info"]["completed"] and r["results"]["l1_error_mean"] > 0 for r in data["runs"])
+    assert [r["info"]["n_particles"] for r in data["runs"]] == [144, 256]
+    assert os.path.getsize(d / "precision.png") > 1000 and "| nx12 |" in open(d / "precision.md").read()
+    s = tmp_path / "stress"
+    # dt factor 40 at nx=12 blows up; it is above the documented factor 1, so the study passes
+    code = main(["stress", "taylor_green", "--runs", "1", "--nx", "12", "--tf", "0.3", "--no-openmp",
+                 "--dt-factor", "1", "40", "-d", str(s)])
+    rows = json.load(open(s / "stress.json"))["runs"]
+    outcome = {r["case"]: r["exit"] for r in rows}
+    assert outcome["dt-factor1_seed0"] == 0 and outcome["dt-factor40_seed0"] == 3
+    assert code == 0 and "blew up" in open(s / "stress.md").read()
+    assert os.path.getsize(s / "stress.png") > 1000
+
+
+def test_stress_fails_when_a_run_blows_up_within_the_stable_factor(tmp_path):
+    code = main(["stress", "taylor_green", "--runs", "1", "--nx", "12", "--tf", "0.3", "--no-openmp",
+                 "--dt-factor", "40", "--stable-factor", "50", "-d", str(tmp_path)])
+    assert code == 1
