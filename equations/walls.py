@@ -57,11 +57,11 @@ class WallPressure(Equation):
     Writes ``p`` and the Shepard sum ``wij`` (which :class:`WallGhostVelocity` reuses).
     """
 
-    switches = ("accelerating", "clamp")
+    switches = ("accelerating", "clamp", "dim")
 
-    def __init__(self, dest, sources, gx=0.0, gy=0.0, gz=0.0, accelerating=False, clamp=False):
+    def __init__(self, dest, sources, gx=0.0, gy=0.0, gz=0.0, accelerating=False, clamp=False, dim=3):
         super().__init__(dest, sources, gx=gx, gy=gy, gz=gz, accelerating=bool(accelerating),
-                         clamp=bool(clamp))
+                         clamp=bool(clamp), dim=int(dim))
 
     def initialize(self, d_idx, d_p, d_wij):
         d_p[d_idx] = 0.0
@@ -69,12 +69,18 @@ class WallPressure(Equation):
 
     def loop(self, d_idx, d_p, d_wij, d_auw, d_avw, d_aww, s_idx, s_p, s_rho, XIJ, WIJ):
         gx = self.gx
-        gy = self.gy
-        gz = self.gz
+        gy = 0.0
+        gz = 0.0
+        if self.dim > 1:
+            gy = self.gy
+        if self.dim > 2:
+            gz = self.gz
         if self.accelerating:
             gx = gx - d_auw[d_idx]
-            gy = gy - d_avw[d_idx]
-            gz = gz - d_aww[d_idx]
+            if self.dim > 1:
+                gy = gy - d_avw[d_idx]
+            if self.dim > 2:
+                gz = gz - d_aww[d_idx]
         gdotr = gx * XIJ[0] + gy * XIJ[1] + gz * XIJ[2]
         d_p[d_idx] += (s_p[s_idx] + s_rho[s_idx] * gdotr) * WIJ
         d_wij[d_idx] += WIJ
@@ -156,8 +162,10 @@ class WallGhostVelocity(Equation):
         ww = 0.0
         if self.moving:
             uw = d_uw[d_idx]
-            vw = d_vw[d_idx]
-            ww = d_ww[d_idx]
+            if self.dim > 1:
+                vw = d_vw[d_idx]
+            if self.dim > 2:
+                ww = d_ww[d_idx]
         if self.slip:
             nx = d_normal[3 * d_idx]
             ny = d_normal[3 * d_idx + 1]
@@ -184,19 +192,25 @@ class WallContinuity(Equation):
     :class:`WallGhostVelocity`.
     """
 
-    switches = ("moving",)
+    switches = ("moving", "dim")
 
-    def __init__(self, dest, sources, moving=False):
-        super().__init__(dest, sources, moving=bool(moving))
+    def __init__(self, dest, sources, moving=False, dim=3):
+        super().__init__(dest, sources, moving=bool(moving), dim=int(dim))
 
     def loop(self, d_idx, d_arho, d_rho, d_u, d_v, d_w, s_idx, s_m, s_rho, s_uw, s_vw, s_ww, DWIJ):
         du = d_u[d_idx]
-        dv = d_v[d_idx]
-        dw = d_w[d_idx]
+        dv = 0.0
+        dw = 0.0
+        if self.dim > 1:
+            dv = d_v[d_idx]
+        if self.dim > 2:
+            dw = d_w[d_idx]
         if self.moving:
             du = du - s_uw[s_idx]
-            dv = dv - s_vw[s_idx]
-            dw = dw - s_ww[s_idx]
+            if self.dim > 1:
+                dv = dv - s_vw[s_idx]
+            if self.dim > 2:
+                dw = dw - s_ww[s_idx]
         udotdw = du * DWIJ[0] + dv * DWIJ[1] + dw * DWIJ[2]
         d_arho[d_idx] += d_rho[d_idx] * s_m[s_idx] / s_rho[s_idx] * udotdw
 
@@ -206,8 +220,11 @@ class WallViscosity(Equation):
     (Morris et al. 1997 form with the AHA ghost velocity u_g of eq. 23; dest: a fluid,
     sources: walls with :class:`WallGhostVelocity`).  ``nu`` = 0 removes it."""
 
-    switches = ("nu",)
+    switches = ("nu", "dim")
     nonnegative = ("nu",)
+
+    def __init__(self, dest, sources, nu=0.0, dim=3):
+        super().__init__(dest, sources, nu=nu, dim=int(dim))
 
     def loop(self, d_idx, d_au, d_av, d_aw, d_u, d_v, d_w, d_rho, s_idx, s_m, s_rho,
              s_ug, s_vg, s_wg, XIJ, DWIJ, R2IJ, EPS):
@@ -215,8 +232,10 @@ class WallViscosity(Equation):
             xdotdw = XIJ[0] * DWIJ[0] + XIJ[1] * DWIJ[1] + XIJ[2] * DWIJ[2]
             f = s_m[s_idx] * 4.0 * self.nu * xdotdw / ((d_rho[d_idx] + s_rho[s_idx]) * (R2IJ + EPS))
             d_au[d_idx] += f * (d_u[d_idx] - s_ug[s_idx])
-            d_av[d_idx] += f * (d_v[d_idx] - s_vg[s_idx])
-            d_aw[d_idx] += f * (d_w[d_idx] - s_wg[s_idx])
+            if self.dim > 1:
+                d_av[d_idx] += f * (d_v[d_idx] - s_vg[s_idx])
+            if self.dim > 2:
+                d_aw[d_idx] += f * (d_w[d_idx] - s_wg[s_idx])
 
 
 class WallArtificialViscosity(Equation):
@@ -225,22 +244,28 @@ class WallArtificialViscosity(Equation):
     Pi = (-alpha c0 mu + beta mu^2) / rho_bar, mu = h u_aw . r_aw / (r^2 + 0.01 h^2)
     for u_aw . r_aw < 0 (Monaghan 1992).  ``alpha`` = ``beta`` = 0 removes it."""
 
-    switches = ("alpha", "beta", "moving")
+    switches = ("alpha", "beta", "moving", "dim")
     nonnegative = ("alpha", "beta", "c0")
 
-    def __init__(self, dest, sources, alpha=0.1, beta=0.0, c0=1.0, moving=False):
-        super().__init__(dest, sources, alpha=alpha, beta=beta, c0=c0, moving=bool(moving))
+    def __init__(self, dest, sources, alpha=0.1, beta=0.0, c0=1.0, moving=False, dim=3):
+        super().__init__(dest, sources, alpha=alpha, beta=beta, c0=c0, moving=bool(moving), dim=int(dim))
 
     def loop(self, d_idx, d_au, d_av, d_aw, d_u, d_v, d_w, d_rho, s_idx, s_m, s_rho,
              s_uw, s_vw, s_ww, XIJ, DWIJ, R2IJ, HIJ, EPS):
         if self.alpha != 0.0 or self.beta != 0.0:
             du = d_u[d_idx]
-            dv = d_v[d_idx]
-            dw = d_w[d_idx]
+            dv = 0.0
+            dw = 0.0
+            if self.dim > 1:
+                dv = d_v[d_idx]
+            if self.dim > 2:
+                dw = d_w[d_idx]
             if self.moving:
                 du = du - s_uw[s_idx]
-                dv = dv - s_vw[s_idx]
-                dw = dw - s_ww[s_idx]
+                if self.dim > 1:
+                    dv = dv - s_vw[s_idx]
+                if self.dim > 2:
+                    dw = dw - s_ww[s_idx]
             vr = du * XIJ[0] + dv * XIJ[1] + dw * XIJ[2]
             if vr < 0.0:
                 mu = HIJ * vr / (R2IJ + EPS)
@@ -257,22 +282,28 @@ class WallEDACPressureRate(Equation):
     + 4 nu_edac rho_a (p_a - p_w) r_aw . grad W_aw / ((rho_a + rho_w)(r^2 + 0.01 h^2))],
     V_w = m_w/rho_w, u_w the prescribed wall velocity (dest: a fluid, sources: walls)."""
 
-    switches = ("moving",)
+    switches = ("moving", "dim")
     positive = ("c0",)
     nonnegative = ("nu_edac",)
 
-    def __init__(self, dest, sources, c0=1.0, nu_edac=0.0, moving=False):
-        super().__init__(dest, sources, c0=c0, nu_edac=nu_edac, moving=bool(moving))
+    def __init__(self, dest, sources, c0=1.0, nu_edac=0.0, moving=False, dim=3):
+        super().__init__(dest, sources, c0=c0, nu_edac=nu_edac, moving=bool(moving), dim=int(dim))
 
     def loop(self, d_idx, d_ap, d_rho, d_p, d_u, d_v, d_w, s_idx, s_m, s_rho, s_p,
              s_uw, s_vw, s_ww, XIJ, DWIJ, R2IJ, EPS):
         du = d_u[d_idx]
-        dv = d_v[d_idx]
-        dw = d_w[d_idx]
+        dv = 0.0
+        dw = 0.0
+        if self.dim > 1:
+            dv = d_v[d_idx]
+        if self.dim > 2:
+            dw = d_w[d_idx]
         if self.moving:
             du = du - s_uw[s_idx]
-            dv = dv - s_vw[s_idx]
-            dw = dw - s_ww[s_idx]
+            if self.dim > 1:
+                dv = dv - s_vw[s_idx]
+            if self.dim > 2:
+                dw = dw - s_ww[s_idx]
         vb = s_m[s_idx] / s_rho[s_idx]
         udotdw = du * DWIJ[0] + dv * DWIJ[1] + dw * DWIJ[2]
         xdotdw = XIJ[0] * DWIJ[0] + XIJ[1] * DWIJ[1] + XIJ[2] * DWIJ[2]

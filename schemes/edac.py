@@ -133,7 +133,7 @@ class EDACScheme(Scheme):
         for d in f:
             pressure.append(EDACPressureRate(d, f, c0=self.c0, nu_edac=nu_edac))
             pressure += [WallEDACPressureRate(d, [s], c0=self.c0, nu_edac=nu_edac,
-                                              moving=s in self.moving_walls) for s in w]
+                                              moving=s in self.moving_walls, dim=self.dim) for s in w]
         pressure = [Group(pressure)]
         momentum = []
         for d in f:
@@ -141,9 +141,9 @@ class EDACScheme(Scheme):
                          LaminarViscosity(d, f, nu=self.nu),
                          ArtificialViscosity(d, f, alpha=self.alpha, c0=self.c0)]
             if w:
-                momentum.append(WallViscosity(d, w, nu=self.nu))
+                momentum.append(WallViscosity(d, w, nu=self.nu, dim=self.dim))
                 momentum += [WallArtificialViscosity(d, [s], alpha=self.alpha, c0=self.c0,
-                                                     moving=s in self.moving_walls) for s in w]
+                                                     moving=s in self.moving_walls, dim=self.dim) for s in w]
             if shift:
                 momentum.append(TransportStress(d, f))
             if self.pst == "sun2019":
@@ -164,7 +164,7 @@ class EDACScheme(Scheme):
         g = dict(gx=self.gx, gy=self.gy, gz=self.gz)
         walls = []
         for d in w:
-            walls += [WallPressure(d, f, **g),
+            walls += [WallPressure(d, f, dim=self.dim, **g),
                       WallDensity(d, eos="linear", rho0=self.rho0, c0=self.c0),
                       WallGhostVelocity(d, f, slip=self.slip, moving=d in self.moving_walls, dim=self.dim)]
         return [pressure, [density, Group(walls), Group(momentum)]]

@@ -177,24 +177,24 @@ class WCSPHScheme(Scheme):
             weqs = []
             for d in w:
                 moving = d in self.moving_walls
-                weqs += [WallPressure(d, f, clamp=self.clamp_wall_pressure, **g),
+                weqs += [WallPressure(d, f, clamp=self.clamp_wall_pressure, dim=self.dim, **g),
                          WallDensity(d, eos="tait", rho0=self.rho0, c0=self.c0, gamma=self.gamma),
                          WallGhostVelocity(d, f, slip=self.slip, moving=moving, dim=self.dim)]
             groups.append(Group(weqs))
         eqs = []
         for d in f:
             eqs.append(ContinuityEquation(d, f))
-            eqs += [WallContinuity(d, [s], moving=s in self.moving_walls) for s in w]
+            eqs += [WallContinuity(d, [s], moving=s in self.moving_walls, dim=self.dim) for s in w]
             eqs.append(DensityDiffusion(d, f, delta=self.delta, c0=self.c0,
                                         correction=self.delta_correction))
             eqs.append(PressureGradient(d, f + w, bql=False))
             eqs.append(MonaghanArtificialViscosity(d, f, alpha=self.alpha, beta=self.beta, c0=self.c0))
             if self.wall_alpha:
                 eqs += [WallArtificialViscosity(d, [s], alpha=self.alpha, beta=self.beta, c0=self.c0,
-                                                moving=s in self.moving_walls) for s in w]
+                                                moving=s in self.moving_walls, dim=self.dim) for s in w]
             eqs.append(LaminarViscosity(d, f, nu=self.nu))
             if w:
-                eqs.append(WallViscosity(d, w, nu=self.nu))
+                eqs.append(WallViscosity(d, w, nu=self.nu, dim=self.dim))
             eqs.append(BodyForce(d, tdamp=self.tdamp, **g))
         groups.append(Group(eqs))
         return groups
