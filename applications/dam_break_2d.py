@@ -7,7 +7,8 @@ Differences from PySPH, chosen and documented: sphgen's kernel is the quintic sp
 (support 3h) with h = dx (PySPH: Wendland quintic, support 2h, h = 1.3 dx: 3 dx against
 2.6 dx of support); three layers of Adami walls (PySPH: dummy particles with the
 continuity equation); the column starts in hydrostatic equilibrium (rho from the Tait
-equation with p = rho0 g (2L - y), m = rho dx^2), PySPH starts at rho0; delta-SPH
+equation with p = rho0 g (2L - y), m = rho dx^2), PySPH starts at rho0 and p = 0
+(``--initial-state uniform``); delta-SPH
 (delta = 0.1) is on by default (``--delta 0`` gives plain WCSPH).
 
 The default ``--dx 0.03`` is PySPH's (h = 0.039 = 1.3 dx), rounded so that L/dx is a whole
@@ -95,6 +96,9 @@ class DamBreak2D(Application):
                            help="c0 = factor * sqrt(2 g H) (default %(default)s)")
         group.add_argument("--wall-alpha", type=int, choices=(0, 1), default=1,
                            help="artificial viscosity against the walls too (default 1)")
+        group.add_argument("--initial-state", choices=("hydrostatic", "uniform"), default="hydrostatic",
+                           help="column at hydrostatic density and pressure (default), or at rho0 and "
+                                "p = 0 everywhere as in PySPH's example")
         group.add_argument("--record-every", type=float, default=0.005,
                            help="time between toe/energy samples (default %(default)s s)")
 
@@ -119,9 +123,12 @@ class DamBreak2D(Application):
         dx, h = self.dx, self.h
         x, y = rectangle(0.0, L, 0.0, H, dx)
         b = RHO0 * self.c0 ** 2 / 7.0
-        rho = RHO0 * (1.0 + RHO0 * G * (H - y) / b) ** (1.0 / 7.0)
+        p = RHO0 * G * (H - y)
+        if self.options.initial_state == "uniform":
+            p = 0.0 * y
+        rho = RHO0 * (1.0 + p / b) ** (1.0 / 7.0)
         fluid = ParticleArray("fluid", x=x, y=y, rho=rho, m=rho * dx * dx, h=np.full(x.size, h))
-        fluid.add_property("p", data=RHO0 * G * (H - y))
+        fluid.add_property("p", data=p)
         xw, yw, nx, ny = wall_layers_box(0.0, TANK_W, 0.0, TANK_H, dx, self.n_layers, open_top=True)
         wall = ParticleArray("wall", x=xw, y=yw, rho=np.full(xw.size, RHO0),
                              m=np.full(xw.size, RHO0 * dx * dx), h=np.full(xw.size, h))

@@ -83,8 +83,10 @@ class RenormalisedDensityGradient(Equation):
             inv3(a, ai)
             for i in range(3):
                 g[i] = d_gradrho[3 * d_idx + i]
+            # with A = sum_b (x_b - x_a) (x) grad W V_b, a linear rho = b . x gives
+            # sum_b (rho_b - rho_a) grad W V_b = A^T b: the gradient is A^-T times the sum
             for i in range(3):
-                d_gradrho[3 * d_idx + i] = ai[3 * i] * g[0] + ai[3 * i + 1] * g[1] + ai[3 * i + 2] * g[2]
+                d_gradrho[3 * d_idx + i] = ai[i] * g[0] + ai[3 + i] * g[1] + ai[6 + i] * g[2]
 
 
 class DensityDiffusion(Equation):
@@ -102,16 +104,18 @@ class DensityDiffusion(Equation):
         super().__init__(dest, sources, delta=delta, c0=c0, correction=bool(correction))
 
     def loop(self, d_idx, d_arho, d_rho, d_gradrho, s_idx, s_m, s_rho, s_gradrho,
-             XIJ, DWIJ, R2IJ, EPS, HIJ):
+             XIJ, DWIJ, R2IJ, HIJ):
         if self.delta != 0.0:
-            vb = s_m[s_idx] / s_rho[s_idx]
-            xdotdw = XIJ[0] * DWIJ[0] + XIJ[1] * DWIJ[1] + XIJ[2] * DWIJ[2]
-            # (x_b - x_a) . grad W = -XIJ . DWIJ
-            psidw = -2.0 * (s_rho[s_idx] - d_rho[d_idx]) * xdotdw / (R2IJ + EPS)
-            if self.correction:
-                for i in range(3):
-                    psidw -= (d_gradrho[3 * d_idx + i] + s_gradrho[3 * s_idx + i]) * DWIJ[i]
-            d_arho[d_idx] += self.delta * HIJ * self.c0 * psidw * vb
+            if R2IJ > 1e-12 * HIJ * HIJ:
+                vb = s_m[s_idx] / s_rho[s_idx]
+                xdotdw = XIJ[0] * DWIJ[0] + XIJ[1] * DWIJ[1] + XIJ[2] * DWIJ[2]
+                # (x_b - x_a) . grad W = -XIJ . DWIJ; 1/r^2 unregularised as in the papers (the
+                # pair term is bounded: xdotdw ~ r W'), so a linear rho gives exactly zero
+                psidw = -2.0 * (s_rho[s_idx] - d_rho[d_idx]) * xdotdw / R2IJ
+                if self.correction:
+                    for i in range(3):
+                        psidw -= (d_gradrho[3 * d_idx + i] + s_gradrho[3 * s_idx + i]) * DWIJ[i]
+                d_arho[d_idx] += self.delta * HIJ * self.c0 * psidw * vb
 
 
 class MonaghanArtificialViscosity(Equation):

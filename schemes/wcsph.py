@@ -248,8 +248,8 @@ class WCSPHScheme(Scheme):
             if pa.name not in self.fluids:
                 continue
             m, rho = pa.m, pa.rho
-            vel = [pa.data[c] for c in ("u", "v", "w")[:self.dim]]
-            pos = [pa.data[c] for c in ("x", "y", "z")[:self.dim]]
+            vel = [pa.data.get(c, 0.0) for c in ("u", "v", "w")[:self.dim]]
+            pos = [pa.data.get(c, 0.0) for c in ("x", "y", "z")[:self.dim]]
             ke += 0.5 * float(np.sum(m * sum(c * c for c in vel)))
             pe -= float(np.sum(m * sum(gi * xi for gi, xi in zip(g, pos))))
             r = rho / self.rho0
