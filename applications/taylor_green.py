@@ -43,6 +43,7 @@ class TaylorGreen(Application):
     history_columns = ("t", "max_u", "max_u_exact", "l1_error", "kinetic_energy",
                        "kinetic_energy_exact", "max_density_error")
     error_key = "l1_error_mean"   # what `sphgen precision` plots against run time
+    diagnostics = ("mass", "linear_momentum", "angular_momentum", "kinetic_energy")
 
     def add_user_options(self, group):
         group.add_argument("--nx", type=int, default=50, help="particles per side (default %(default)s)")
@@ -54,6 +55,9 @@ class TaylorGreen(Application):
         group.add_argument("--perturb", type=float, default=0.0,
                            help="random lattice perturbation in units of dx (default 0)")
         group.add_argument("--seed", type=int, default=1, help="seed of the perturbation (default 1)")
+        group.add_argument("--no-bql", dest="bql", action="store_false",
+                           help="no local mean pressure in the pressure gradient: the pair force is "
+                           "then antisymmetric and momentum is conserved to round-off")
         group.add_argument("--output-vorticity", action="store_true",
                            help="also compute and write the vorticity 'omega'")
 
@@ -90,7 +94,7 @@ class TaylorGreen(Application):
 
     def create_scheme(self):
         s = EDACScheme(["fluid"], dim=2, rho0=1.0, c0=self.options.c0, nu=self.nu, h=self.h,
-                       dx=self.dx, umax=1.0, pst=self.options.pst)
+                       dx=self.dx, umax=1.0, pst=self.options.pst, bql=self.options.bql)
         if self.options.output_vorticity:
             s.output_props = s.output_props + ("omega",)
         return s

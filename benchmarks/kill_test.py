@@ -75,8 +75,8 @@ def restart_and_compare(outdir, files, ref, threads):
     diff = max(float(np.max(np.abs(data[p] - ref_data[p]))) for p in ("x", "y", "u", "v", "p"))
     same_hist = json.load(open(os.path.join(outdir, "history.json"))) == \
         json.load(open(os.path.join(ref, "history.json")))
-    same_res = json.load(open(os.path.join(outdir, "results.json"))) == \
-        json.load(open(os.path.join(ref, "results.json")))
+    same_res = all(json.load(open(os.path.join(outdir, n))) == json.load(open(os.path.join(ref, n)))
+                   for n in ("results.json", "diagnostics.json"))
     io.verify_xdmf(os.path.join(outdir, "taylor_green.xdmf"))
     return {"step": step == ref_step, "max_diff": diff, "history": same_hist, "results": same_res,
             "stray_after": stray}

@@ -60,13 +60,17 @@ class Application:
 
     Time series: append rows (first column t) to ``self.history`` and name the columns in
     ``history_columns``; ``history.json`` is written with every output, continues across
-    restarts, and carries ``history_meta()``.
+    restarts, and carries ``history_meta()``.  Conserved quantities listed in
+    ``diagnostics`` are sampled every ``diagnostics_every`` steps into ``diagnostics.json``
+    (same rules) and plotted in ``diagnostics.png``.
     """
 
     tf = 1.0
     pfreq = 100
     dim = 2
     history_columns = None
+    diagnostics = ()           # names in sphgen.tools.diagnostics.DIAGNOSTICS, or "energies"
+    diagnostics_every = 10     # steps between diagnostic samples
 
     def __init__(self, name=None):
         self.name = name or type(self).__module__.rsplit(".", 1)[-1]
@@ -74,6 +78,7 @@ class Application:
         self.scene = self.solver = self.scheme = None
         self.history = []
         self.restarts = []
+        self.diag = None
 
     # ---------------------------------------------------------------- hooks
     def add_user_options(self, parser):
@@ -199,7 +204,15 @@ class Application:
                         metadata={"signature": self.signature, "tf": opts.tf})
         solver.post_step_callbacks.append(self.post_step)
         solver.output_callbacks.append(lambda s, path: self._write_progress())
+        if self.diagnostics:
+            from .tools.diagnostics import Diagnostics
+            self.diag = Diagnostics(self.diagnostics, self.dim, self.scheme)
+            solver.post_step_callbacks.append(self._sample)
         return solver
+
+    def _sample(self, solver):
+        if solver.step % self.diagnostics_every == 0 or solver.t >= solver.tf - 1e-12 * max(1.0, solver.tf):
+            self.diag.sample(solver.t, self.scene.arrays)
 
     def _restart(self, path, data, dt):
         """Continue the run of ``path``: its state, history and record of restarts."""
@@ -211,6 +224,9 @@ class Application:
             self.history = [list(r) for r in hist["rows"]]
         else:
             print(f"sphgen: restart: no history.json beside {path}; the time series starts here")
+        diag = run_folder.earlier_history(path, self.solver.t, "diagnostics.json")
+        if self.diag is not None and diag is not None:
+            self.diag.rows = [list(r) for r in diag["rows"]]
         if run_folder.same_folder(path, self.outdir):
             self.restarts = list(run_folder.earlier_info(self.outdir).get("restarts", []))
         self.restarts.append({"from": os.path.abspath(path), "t": self.solver.t, "step": self.solver.step,
@@ -219,6 +235,8 @@ class Application:
     def _execute(self):
         """Run the solver with info.json and history.json kept current; then post-process."""
         outdir = self.outdir
+        if self.diag is not None and not self.solver.restarted:
+            self.diag.sample(self.solver.t, self.scene.arrays)
         self._write_progress()
         error = None
         try:
@@ -233,6 +251,9 @@ class Application:
         print(f"{self.name}: {self.solver.step} steps to t={self.solver.t:.6g} in {self.solver.wall_time:.2f} s "
               f"(compile {self.scene.compile_time:.2f} s, {self.scene.threads} thread(s)); output in {outdir}")
         self.post_process(outdir)
+        if self.diag is not None:
+            from .tools.plots import plot_series
+            plot_series(os.path.join(outdir, "diagnostics.json"), os.path.join(outdir, "diagnostics.png"))
         return self._info(True)
 
     def _write_progress(self, completed=False, error=None):
@@ -240,6 +261,9 @@ class Application:
         if self.history_columns is not None:
             io.write_json(os.path.join(self.outdir, "history.json"),
                           {"columns": list(self.history_columns), "rows": self.history, **self.history_meta()})
+        if self.diag is not None:
+            io.write_json(os.path.join(self.outdir, "diagnostics.json"),
+                          {"columns": self.diag.columns(self.scene.arrays), "rows": self.diag.rows})
         io.write_json(os.path.join(self.outdir, "info.json"), self._info(completed, error))
 
     def _signature(self, arrays):

@@ -275,7 +275,7 @@ def step_of(path):
 
 # ------------------------------------------------------------------ folders
 _TMP = re.compile(r"^.+\.tmp-(?P<pid>\d+)$")
-RUN_FILES = ("info.json", "results.json", "history.json")
+RUN_FILES = ("info.json", "results.json", "history.json", "diagnostics.json")
 
 
 def _pid_alive(pid):

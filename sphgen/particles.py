@@ -54,9 +54,14 @@ class ParticleArray:
         object.__setattr__(self, "n", int(n))
         for p in ("x", "y", "z", "u", "v", "w", "m", "h", "rho"):
             self.add_property(p)
+        self.add_property("gid", dtype="int")
         for k, v in props.items():
-            self.add_property(k)
+            if k not in self.props:
+                self.add_property(k)
             self.set(k, v)
+        if "gid" not in self.data:
+            # a persistent id: sorting moves particles in memory, gid follows them
+            self.set("gid", np.arange(self.n))
         for k, v in (constants or {}).items():
             self.add_constant(k, v)
 

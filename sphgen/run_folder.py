@@ -100,9 +100,9 @@ def restart_notes(data, dt, tf):
     return notes
 
 
-def earlier_history(restart, t):
-    """The history rows (first column t) of the restarted run up to time ``t``."""
-    path = os.path.join(os.path.dirname(os.path.abspath(restart)), "history.json")
+def earlier_history(restart, t, name="history.json"):
+    """The rows (first column t) of a time series of the restarted run up to time ``t``."""
+    path = os.path.join(os.path.dirname(os.path.abspath(restart)), name)
     try:
         with open(path) as f:
             hist = json.load(f)

@@ -216,7 +216,8 @@ def test_write_xdmf(tmp_path):
         assert "unused" not in atts
         assert atts["vel"].find("DataItem").get("Dimensions") == "5 3"
         assert atts["tau"].find("DataItem").get("Dimensions") == "5 9"
-    assert n_refs == 3 * ((3 + 7) + (3 + 4))  # per file: fluid and solid geometry + attributes
+    # per file: fluid and solid geometry + attributes (each with its persistent id gid)
+    assert n_refs == 3 * ((3 + 8) + (3 + 5))
     assert not [f for f in os.listdir(tmp_path) if ".tmp-" in f]
 
 

@@ -427,7 +427,7 @@ def test_sort_rejects_a_frozen_list_of_another_particle_count():
     nn = NeighbourSearch([pa], 2, 2.0, sort=False)
     nn.freeze("fluid", "fluid")
     object.__setattr__(pa, "n", 80)
-    for p in ("x", "y", "z", "h", "id"):
+    for p in ("x", "y", "z", "h", "id", "gid"):
         pa.data[p] = pa.data[p][:80].copy()
     with pytest.raises(ValueError, match="particle count change since freeze"):
         nn.sort()

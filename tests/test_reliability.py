@@ -147,7 +147,7 @@ def test_sigkill_leaves_readable_files_and_restart_is_bit_for_bit(tmp_path):
     assert a["solver_data"]["step"] == b["solver_data"]["step"]
     for prop in ("x", "y", "u", "v", "p", "rho"):
         np.testing.assert_array_equal(a["arrays"]["fluid"].data[prop], b["arrays"]["fluid"].data[prop])
-    for name in ("history.json", "results.json"):
+    for name in ("history.json", "results.json", "diagnostics.json"):
         assert json.load(open(ref / name)) == json.load(open(out / name)), name
     info = json.load(open(out / "info.json"))
     assert info["completed"] is True and info["restarts"][-1]["step"] == io.step_of(files[-1])
