@@ -1,7 +1,7 @@
 """Plane Couette flow: the top plate moves at U, EDAC with Adami walls, periodic in x.
 
 The channel of :mod:`sphgen.applications.poiseuille` (plates at y = 0 and y = d = 1, three
-layers of wall particles each, periodic over 0.4 d, ``--ny`` particles across, h = dx,
+layers of wall particles each, periodic over d, ``--ny`` particles across, h = dx,
 c0 = 10 U, rho0 = 1, nu = U d / Re with ``--re`` default 1) without body force: the top
 wall carries the prescribed velocity ``uw = U`` (a *moving* wall in the sense of
 :mod:`sphgen.equations.walls`; the bottom wall is at rest and has no velocity arrays in

@@ -2,7 +2,7 @@
 
 Set-up after Morris, Fox & Zhu (1997, section 4.1) and Adami, Hu & Adams (2012, 2013):
 plates at y = 0 and y = d = 1 (three layers of wall particles each, no slip by the ghost
-velocity of AHA eqs. 22-23), periodic in x over a length 0.4 d, fluid at rest at t = 0,
+velocity of AHA eqs. 22-23), periodic in x over a length d, fluid at rest at t = 0,
 driven by a body force F along x with rho0 = 1, kinematic viscosity nu, u_max = F d^2/(8 nu)
 = 1 and Re = u_max d / nu = ``--re`` (default 1).  ``--ny`` particles across the channel
 (default 30), h = dx, c0 = 10 u_max, no particle shifting (the streamlines are straight).
@@ -36,7 +36,7 @@ except ImportError:  # pragma: no cover
     InputError = ValueError
 
 D = 1.0         # channel width
-LX = 0.4 * D    # periodic length
+LX = D          # periodic length (fixed, so every resolution shares one compiled module)
 RHO0 = 1.0
 UMAX = 1.0
 
@@ -70,8 +70,9 @@ class ChannelFlow:
                            help="time between profile samples (default %(default)s)")
 
     def consume_user_options(self, o):
-        if o.ny < 6:
-            raise InputError(f"--ny must be at least 6, got {o.ny}")
+        if o.ny < 7:
+            raise InputError(f"--ny must be at least 7 (the periodic length must exceed the kernel "
+                             f"support twice), got {o.ny}")
         for name in ("re", "c0_factor", "record_every"):
             v = getattr(o, name)
             if not (np.isfinite(v) and v > 0):
@@ -87,9 +88,7 @@ class ChannelFlow:
 
     def create_particles(self):
         dx = self.dx
-        nx = max(int(round(LX / dx)), 7)
-        lx = nx * dx
-        self.lx = lx
+        self.lx = lx = LX
         x, y = rectangle(0.0, lx, 0.0, D, dx)
         fluid = ParticleArray("fluid", x=x, y=y, rho=np.full(x.size, RHO0), m=np.full(x.size, RHO0 * dx * dx),
                               h=np.full(x.size, self.h))

@@ -62,10 +62,10 @@ def run_wcsph(backend, steps=3, **kw):
     return arrays, sc
 
 
-@pytest.mark.parametrize("kw", [
-    dict(delta=0.1, nu=0.01, beta=0.2, tdamp=0.5),                          # Antuono delta-SPH, no slip
-    dict(delta=0.1, delta_correction=False, nu=0.01, slip=True, clamp_wall_pressure=True),
-])
+# One compiled variant (every module costs ~15 s of compiling on a cold cache): free slip and
+# the wall-pressure clamp are compared compiled vs Python in test_walls, the Molteni-Colagrossi
+# diffusion (delta_correction=False) in Python below.
+@pytest.mark.parametrize("kw", [dict(delta=0.1, nu=0.01, beta=0.2, tdamp=0.5)])
 def test_wcsph_scheme_compiled_matches_python(kw):
     a, sc = run_wcsph("cython", **kw)
     b, _ = run_wcsph("python", **kw)
