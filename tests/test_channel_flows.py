@@ -51,3 +51,12 @@ def test_channel_flow_reaches_the_exact_profile(name, tol, tmp_path):
     t, dev_tr = rows[:, 0], rows[:, 1]
     assert np.all(dev_tr[t >= 0.1] < 0.03)
     assert abs(res["u_mid"] - res["u_mid_exact"]) < tol
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["poiseuille", "couette"])
+def test_channel_flow_full_run(name, tmp_path):
+    """Default set-up (30 particles across, Re = 1, t = 1.5 d^2/nu): within 2 % of u_max."""
+    _, res = run_app(name, [], tmp_path)
+    assert res["t_over_d2_nu"] == pytest.approx(1.5)
+    assert res["max_dev_steady_over_umax"] < 0.02
