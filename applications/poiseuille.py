@@ -101,7 +101,7 @@ class ChannelFlow:
             w.add_property("normal", stride=3,
                            data=np.column_stack([0 * xw, np.full(xw.size, ny), 0 * xw]).ravel())
             if name == "top" and self.moving_top:
-                for p, v in (("uw", UMAX), ("vw", 0.0), ("ww", 0.0)):
+                for p, v in (("uw", UMAX), ("vw", 0.0)):   # 2D: no ww
                     w.add_property(p, data=np.full(xw.size, v))
             walls.append(w)
         return [fluid] + walls
