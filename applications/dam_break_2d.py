@@ -81,6 +81,8 @@ class DamBreak2D(Application):
     dim = 2
     history_columns = ("t", "T", "toe", "kinetic", "potential", "internal", "total",
                        "mass_inside", "n_outside", "rho_mean")
+    diagnostics = ("mass", "energies", "density_range", "pressure_range")
+    diagnostics_every = 50
 
     def add_user_options(self, group):
         group.add_argument("--dx", type=float, default=0.03,

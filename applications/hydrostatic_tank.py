@@ -45,6 +45,8 @@ class HydrostaticTank(Application):
     pfreq = 2000
     dim = 2
     history_columns = ("t", "p_bottom_rel", "u_rms_rel", "u_max_rel")
+    diagnostics = ("mass", "energies", "density_range", "pressure_range")
+    diagnostics_every = 50
 
     def add_user_options(self, group):
         group.add_argument("--nh", type=int, default=40, help="H/dx, particles over the depth (default %(default)s)")
