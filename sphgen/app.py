@@ -188,7 +188,7 @@ class Application:
 
     def _scene(self, arrays, integrator):
         opts = self.options
-        outputs = {pa.name: [p for p in self.scheme.output_props if pa.has(p)] for pa in arrays}
+        outputs = {pa.name: self.scheme.output_properties(pa) for pa in arrays}
         return Scene(arrays, self.scheme.get_equations(), steppers=integrator.steppers,
                      kernel=getattr(self.scheme, "kernel", None), dim=self.dim,
                      domain=self.create_domain(), outputs=outputs, backend=opts.backend,

@@ -58,6 +58,17 @@ class Scheme:
     def get_timestep(self):
         raise NotImplementedError
 
+    def output_properties(self, pa):
+        """The properties of array ``pa`` written to the output files (roots of pruning).
+
+        A wall at rest (in ``walls`` but not ``moving_walls``) writes no velocities, so it
+        carries none unless an equation reads them.
+        """
+        props = [p for p in self.output_props if pa.has(p)]
+        if pa.name in getattr(self, "walls", ()) and pa.name not in getattr(self, "moving_walls", ()):
+            props = [p for p in props if p not in ("u", "v", "w")]
+        return props
+
     def stability_bounds(self, dt):
         """[Bound] for a run with time step ``dt`` (none by default)."""
         return []

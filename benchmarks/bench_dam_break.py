@@ -1,0 +1,94 @@
+"""Dam break: sphgen's WCSPH against PySPH 1.0b2's ``pysph run dam_break_2d``, same case.
+
+Both codes run the Koshizuka-Oka / Martin-Moyce column (L x 2L in a 4L tank) to
+t = 0.7 s with WCSPH (Tait, artificial viscosity, predictor-corrector), serial and with 2
+threads, interleaved, ``--repeat`` times; medians are printed.  Time per particle-step is
+the time loop's wall time over (steps x all particles, fluid and wall); per fluid
+particle-step too, since the codes lay different numbers of wall layers.  PySPH's steps
+are its time-step computations (profile_info.csv, minus the initial one).
+
+    python benchmarks/bench_dam_break.py [--repeat 3] [--tf 0.7]
+"""
+import argparse
+import csv
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from pysph_baseline import find_pysph_python  # noqa: E402
+
+SPHGEN = os.path.join(os.path.dirname(sys.executable), "sphgen")
+
+
+def sphgen_run(work, tf, threads):
+    out = os.path.join(work, f"sphgen_t{threads}")
+    cmd = [SPHGEN, "run", "dam_break_2d", "--tf", str(tf), "--disable-output", "--no-progress",
+           "--overwrite", "-d", out]
+    cmd += ["--no-openmp"] if threads == 1 else ["--threads", str(threads)]
+    subprocess.run(cmd, check=True, capture_output=True, env=dict(os.environ, SPHGEN_TUNE_THREADS="0"))
+    info = json.load(open(os.path.join(out, "info.json")))
+    n, steps, wall = info["n_particles"], info["steps"], info["wall_time"]
+    return {"wall": wall, "steps": steps, "n": n, "fluid": info["particles"]["fluid"],
+            "pairs_per_s": info["neighbour_pairs_per_step"] * steps / wall}
+
+
+def pysph_run(py, work, tf, threads):
+    out = os.path.join(work, f"pysph_t{threads}")
+    exe = os.path.join(os.path.dirname(py), "pysph")
+    cmd = [exe, "run", "dam_break_2d", "--tf", str(tf), "--disable-output", "-d", out]
+    cmd += ["--openmp", "--omp-schedule", "static"] if threads > 1 else []
+    env = dict(os.environ, OMP_NUM_THREADS=str(threads))
+    p = subprocess.run(cmd, check=True, capture_output=True, text=True, env=env, cwd=work)
+    wall = float(p.stdout.split("Run took:")[1].split()[0])
+    fluid = int(p.stdout.split("fluid:")[1].split()[0])
+    n = int(p.stdout.split("Total:")[1].split()[0])
+    with open(os.path.join(out, "profile_info.csv")) as f:
+        calls = {r["function"]: int(r["calls"]) for r in csv.DictReader(f)}
+    steps = calls["Solver._get_timestep"] - 1
+    return {"wall": wall, "steps": steps, "n": n, "fluid": fluid}
+
+
+def med(rows, key):
+    return statistics.median(r[key] for r in rows)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--tf", type=float, default=0.7)
+    a = ap.parse_args()
+    py = find_pysph_python()
+    work = tempfile.mkdtemp(prefix="sphgen_db_")
+    sphgen_run(work, 0.001, 1)  # compile once
+    if py:
+        pysph_run(py, work, 0.001, 1)
+        pysph_run(py, work, 0.001, 2)
+    res = {}
+    for _ in range(a.repeat):
+        for threads in (1, 2):
+            res.setdefault(("sphgen", threads), []).append(sphgen_run(work, a.tf, threads))
+            if py:
+                res.setdefault(("pysph", threads), []).append(pysph_run(py, work, a.tf, threads))
+    us = {}
+    for (code, threads), rows in sorted(res.items()):
+        r = rows[0]
+        t_ps = statistics.median(x["wall"] / (x["steps"] * x["n"]) for x in rows) * 1e6
+        t_fs = statistics.median(x["wall"] / (x["steps"] * x["fluid"]) for x in rows) * 1e6
+        us[(code, threads)] = (t_ps, t_fs)
+        pairs = f", {med(rows, 'pairs_per_s'):.3g} neighbour pairs/s" if "pairs_per_s" in r else ""
+        print(f"{code:6s} {threads} thread(s): {r['fluid']} fluid + {r['n'] - r['fluid']} wall, "
+              f"{r['steps']} steps, {med(rows, 'wall'):.2f} s, {t_ps:.3f} us/particle-step, "
+              f"{t_fs:.3f} us/fluid-particle-step{pairs}")
+    for threads in (1, 2):
+        if ("pysph", threads) in us:
+            p, s = us[("pysph", threads)], us[("sphgen", threads)]
+            print(f"PySPH / sphgen, {threads} thread(s): {p[0] / s[0]:.2f}x per particle-step, "
+                  f"{p[1] / s[1]:.2f}x per fluid particle-step")
+
+
+if __name__ == "__main__":
+    main()
