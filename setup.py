@@ -54,7 +54,7 @@ setup(
     version="0.1.0",
     description="SPH equations in restricted Python, compiled per scene to Cython/OpenMP",
     python_requires=">=3.10",
-    packages=["sphgen", "sphgen.codegen", "sphgen.nnps", "sphgen.tools",
+    packages=["sphgen", "sphgen.codegen", "sphgen.codegen.passes", "sphgen.nnps", "sphgen.tools",
               "sphgen.equations", "sphgen.schemes", "sphgen.applications"],
     package_dir={"sphgen.equations": "equations", "sphgen.schemes": "schemes",
                  "sphgen.applications": "applications"},

@@ -10,9 +10,10 @@ An equation is a small class whose methods are restricted Python::
             d_rho[d_idx] += s_m[s_idx] * WIJ
 
 Properties are named by argument: ``d_rho`` is property ``rho`` of the destination,
-``s_m`` of the source.  Pair symbols (``XIJ, RIJ, R2IJ, VIJ, HIJ, WIJ, DWIJ, WDASHIJ,
-GHIJ, EPS``) are computed only when a ``loop`` asks for them.  Pair loops write only
-``d_*[d_idx]`` (gather-only), which keeps the OpenMP loops race-free.
+``s_m`` of the source.  Pair symbols (``XIJ, RIJ, WIJ, DWIJ``, ...: the table in
+:mod:`sphgen.codegen.pair_symbols`) are computed only when a ``loop`` asks for them.
+Pair loops write only ``d_*[d_idx]`` (gather-only), which keeps the OpenMP loops
+race-free.
 """
 import ast
 import difflib
@@ -24,9 +25,6 @@ from compyle.api import declare  # noqa: F401  (re-exported: ``from sphgen.equat
 
 from .errors import SphgenError
 
-PAIR_SYMBOLS = ("XIJ", "RIJ", "R2IJ", "VIJ", "HIJ", "WIJ", "DWIJ", "WDASHIJ", "GHIJ", "EPS")
-VECTOR_SYMBOLS = ("XIJ", "VIJ", "DWIJ")
-SPECIAL_ARGS = ("d_idx", "s_idx", "t", "dt", "NBRS", "N_NBRS")
 PAIR_METHODS = ("loop", "loop_all")
 COMPILED_METHODS = ("initialize", "loop", "loop_all", "post_loop")
 

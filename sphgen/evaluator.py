@@ -2,29 +2,32 @@
 
 It calls the *original* methods (not the specialised ones) with numpy arrays and
 Python floats, one particle and one pair at a time, in the order the compiled module
-uses.  Slow by design; tests compare compiled results against it to round-off, and a
-user can step through a new equation with a debugger.
+uses, and computes the pair symbols with the Python code of the pair-symbol table.
+Slow by design; tests compare compiled results against it to round-off, and a user
+can step through a new equation with a debugger.
 """
 import inspect
-import math
 
 import numpy as np
 
-from .equation import PAIR_METHODS
+from .codegen.backend import Backend
+from .codegen.pair_symbols import SYMBOLS, PythonPair
 
 
-class PythonEvaluator:
+class PythonEvaluator(Backend):
+    """Runs a plan's passes and stages in plain Python (``backend='python'``)."""
+
+    name = "python"
+
     def __init__(self, plan, nnps):
-        self.plan = plan
-        self.nnps = nnps
+        super().__init__(plan, nnps)
         self.arrays = plan.arrays
-        self.kernel = plan.kernel
         self._sig = {}
         self._scratch = {}
 
     def _args(self, func):
         if func not in self._sig:
-            self._sig[func] = [a for a in inspect.signature(func).parameters]
+            self._sig[func] = list(inspect.signature(func).parameters)
         return self._sig[func]
 
     def _props(self, pa, name):
@@ -38,91 +41,58 @@ class PythonEvaluator:
             self._scratch[key] = np.zeros(pa.n * pa.props[name].stride, dtype=pa.props[name].np_dtype)
         return self._scratch[key]
 
-    def _kwargs(self, func, dest, src, d_idx, s_idx, sym, t, dt, nbrs=None):
+    def _call(self, ep, method, dest, src, i, j=None, sym=None, t=0.0, dt=0.0, nbrs=None):
+        """Call a method of an equation (or stepper) with arguments found by name."""
+        f = getattr(ep, method)
+        special = {"d_idx": i, "s_idx": j, "t": t, "dt": dt, "NBRS": nbrs,
+                   "N_NBRS": None if nbrs is None else len(nbrs)}
         kw = {}
-        for a in self._args(func):
-            if a == "d_idx":
-                kw[a] = d_idx
-            elif a == "s_idx":
-                kw[a] = s_idx
+        for a in self._args(f):
+            if a in special:
+                kw[a] = special[a]
             elif a.startswith("d_"):
                 kw[a] = self._props(dest, a[2:])
             elif a.startswith("s_"):
                 kw[a] = self._props(src, a[2:])
-            elif a == "t":
-                kw[a] = t
-            elif a == "dt":
-                kw[a] = dt
-            elif a == "NBRS":
-                kw[a] = nbrs
-            elif a == "N_NBRS":
-                kw[a] = len(nbrs)
             else:
                 kw[a] = sym[a]
-        return kw
+        f(**kw)
 
-    def pair_symbols(self, dest, src, i, j, reference):
-        dim = self.plan.dim
-        pos = ("x0", "y0", "z0") if reference else ("x", "y", "z")
-        xij = [0.0, 0.0, 0.0]
-        for k in range(dim):
-            xij[k] = float(dest.data[pos[k]][i] - src.data[pos[k]][j])
-            dom = self.plan.domain
-            if dom is not None and dom.periodic[k] and not reference:
-                L = float(dom.length[k])
-                if xij[k] > 0.5 * L:
-                    xij[k] -= L
-                elif xij[k] < -0.5 * L:
-                    xij[k] += L
-        r2 = sum(x * x for x in xij[:dim])
-        r = math.sqrt(r2)
-        h = 0.5 * (dest.data["h"][i] + src.data["h"][j])
-        vij = [0.0, 0.0, 0.0]
-        if "u" in dest.data and "u" in src.data:
-            for k, u in enumerate(("u", "v", "w")[:dim]):
-                vij[k] = float(dest.data[u][i] - src.data[u][j])
-        wd = self.kernel.dwdr(r, h)
-        f = wd / r if r > 1e-12 else 0.0
-        return {"XIJ": xij, "RIJ": r, "R2IJ": r2, "HIJ": h, "EPS": 0.01 * h * h, "VIJ": vij,
-                "WIJ": self.kernel.w(r, h), "WDASHIJ": wd, "GHIJ": self.kernel.gradh(r, h),
-                "DWIJ": [f * x for x in xij]}
+    def pair_symbols(self, loop, dest, src, i, j, reference):
+        """The pair symbols a source loop computes, for particle i of dest and j of src."""
+        pair = PythonPair(dest, src, i, j, self.plan.kernel, self.plan.dim, self.plan.domain, reference)
+        for name in loop.symbols:
+            pair.values[name] = SYMBOLS[name].python(pair)
+        return pair.values
 
-    def run_pass(self, gp, dest_name, t, dt):
-        dest = self.arrays[dest_name]
-        eps = gp.dests[dest_name]
-        sources = gp.sources(dest_name)
-        ref = gp.group.reference
-        lists = {s: (self.nnps.reference_neighbours(dest_name, s) if ref else self.nnps.neighbours(dest_name, s))
-                 for s in sources}
+    def _neighbours(self, npass, src):
+        if npass.reference:
+            return self.nnps.reference_neighbours(npass.dest, src)
+        return self.nnps.neighbours(npass.dest, src)
+
+    def _source_loop(self, npass, loop, offsets, i, t, dt):
+        dest, src = self.arrays[npass.dest], self.arrays[loop.source]
+        off, idx = offsets
+        nb = idx[off[i]:off[i + 1]]
+        for j in nb:
+            sym = self.pair_symbols(loop, dest, src, i, int(j), npass.reference)
+            for ep in loop.calls("loop"):
+                self._call(ep.eq, "loop", dest, src, i, int(j), sym, t, dt)
+        for ep in loop.calls("loop_all"):
+            self._call(ep.eq, "loop_all", dest, src, i, t=t, dt=dt, nbrs=nb)
+
+    def run_pass(self, npass, t, dt):
+        dest = self.arrays[npass.dest]
+        lists = [self._neighbours(npass, loop.source) for loop in npass.sources]
         for i in range(dest.n):
-            for ep in eps:
-                if "initialize" in ep.methods:
-                    f = ep.eq.initialize
-                    f(**self._kwargs(f, dest, None, i, None, None, t, dt))
-            for s, lps in sources.items():
-                src = self.arrays[s]
-                off, idx = lists[s]
-                nb = idx[off[i]:off[i + 1]]
-                for j in nb:
-                    sym = self.pair_symbols(dest, src, i, int(j), ref)
-                    for ep in lps:
-                        if "loop" in ep.methods:
-                            f = ep.eq.loop
-                            f(**self._kwargs(f, dest, src, i, int(j), sym, t, dt))
-                for ep in lps:
-                    if "loop_all" in ep.methods:
-                        f = ep.eq.loop_all
-                        f(**self._kwargs(f, dest, src, i, None, None, t, dt, nbrs=nb))
-            for ep in eps:
-                if "post_loop" in ep.methods:
-                    f = ep.eq.post_loop
-                    f(**self._kwargs(f, dest, None, i, None, None, t, dt))
+            for ep in npass.calls("initialize"):
+                self._call(ep.eq, "initialize", dest, None, i, t=t, dt=dt)
+            for loop, offsets in zip(npass.sources, lists):
+                self._source_loop(npass, loop, offsets, i, t, dt)
+            for ep in npass.calls("post_loop"):
+                self._call(ep.eq, "post_loop", dest, None, i, t=t, dt=dt)
 
     def run_stage(self, st, name, t, dt):
         pa = self.arrays[st.array]
-        f = getattr(st.stepper, name)
         for i in range(pa.n):
-            f(**self._kwargs(f, pa, None, i, None, None, t, dt))
-
-
-__all__ = ["PythonEvaluator", "PAIR_METHODS"]
+            self._call(st.stepper, name, pa, None, i, t=t, dt=dt)

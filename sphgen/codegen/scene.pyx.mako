@@ -24,7 +24,7 @@ _keep = {}
 # ---------------------------------------------------------------- particle data
 % for arr, props in allocation:
 cdef long ${arr}_n = 0
-% for prop, ctype in props:
+% for prop, ctype, nptype in props:
 cdef ${ctype}* ${arr}_${prop} = NULL
 % endfor
 % endfor
@@ -138,12 +138,12 @@ def max_speed2():
     cdef long i, im
     cdef double m, s2
     out = []
-% for arr, comps in moving:
+% for arr, speed2 in moving:
     m = 0.0
     im = -1
     with nogil:
         for i in range(${arr}_n):
-            s2 = ${" + ".join(f"{arr}_{u}[i] * {arr}_{u}[i]" for u in comps)}
+            s2 = ${speed2}
             if s2 > m:
                 m = s2
                 im = i
@@ -167,7 +167,7 @@ def bind_arrays(dict arrays):
     global _nthreads
 % for arr, props in allocation:
     global ${arr}_n
-% for prop, ctype in props:
+% for prop, ctype, nptype in props:
     global ${arr}_${prop}
 % endfor
 % endfor
@@ -179,9 +179,9 @@ def bind_arrays(dict arrays):
 % for arr, props in allocation:
     n, d = arrays['${arr}']
     ${arr}_n = n
-% for prop, ctype in props:
+% for prop, ctype, nptype in props:
     a = d['${prop}']
-    if a.dtype != ${'np.float64' if ctype == 'double' else 'np.int32'} or a.size < n:
+    if a.dtype != ${nptype} or a.size < n:
         raise TypeError("${arr}.${prop}: expected ${ctype} data of at least %d values" % n)
     ${arr}_${prop} = <${ctype}*>_ptr(a, '${arr}.${prop}')
 % endfor

@@ -1,32 +1,25 @@
-"""From a restricted-Python method to a specialised Cython function.
+"""From a restricted-Python method to a specialised function (an ``ast.FunctionDef``).
 
 1. ``specialise``: parse the method, fold ``self.<switch>`` into literals, turn other
    ``self.<param>`` into module globals, prune branches whose test became a constant,
    auto-declare integer ``range`` loop counters, drop arguments nobody uses.
-2. ``usage``: which ``d_*``/``s_*`` properties the specialised body reads and writes.
-3. ``to_cython``: hand the specialised function to compyle's CythonGenerator and return a
-   ``cdef inline ... noexcept nogil`` function whose lines carry ``# @src`` markers so a
-   compile error can be traced back to the equation and source line.
+2. ``_usage``: which ``d_*``/``s_*`` properties the specialised body reads and writes.
+3. ``in_registers``: the register-accumulator form of a pair method.
+
+Turning the result into Cython is :mod:`sphgen.codegen.cython`.
 """
 import ast
+import copy
 import inspect
-import linecache
 import textwrap
 import types
 
-from compyle.api import declare  # noqa: F401  (used by translated code)
-from compyle.cython_generator import CythonGenerator
-from compyle.types import KnownType
-
-from ..equation import PAIR_SYMBOLS, VECTOR_SYMBOLS
 from ..errors import SphgenError
+from . import pair_symbols
 
 
 class TranslationError(SphgenError):
     """A method uses Python the generator cannot translate."""
-
-
-_INT_TYPES = {"int": "int*"}
 
 
 def _const_value(node):
@@ -64,7 +57,7 @@ class _Specialiser(ast.NodeTransformer):
     def visit_Subscript(self, node):
         self.generic_visit(node)
         # vector pair symbols have zero components beyond the scene's dimension
-        if isinstance(node.value, ast.Name) and node.value.id in VECTOR_SYMBOLS and \
+        if isinstance(node.value, ast.Name) and pair_symbols.is_vector(node.value.id) and \
                 isinstance(node.ctx, ast.Load) and isinstance(node.slice, ast.Constant) and \
                 isinstance(node.slice.value, int) and node.slice.value >= self.dim:
             return ast.copy_location(ast.Constant(0.0), node)
@@ -226,7 +219,8 @@ class Specialised:
 
     @property
     def pair_symbols(self):
-        return [a for a in self.args if a in PAIR_SYMBOLS]
+        """The pair symbols among its arguments."""
+        return [a for a in self.args if a in pair_symbols.SYMBOLS]
 
 
 def indexed_only_by_d_idx(spec):
@@ -244,6 +238,19 @@ def indexed_only_by_d_idx(spec):
     return ok
 
 
+class _RegisterForm(ast.NodeTransformer):
+    """Index the named arguments with 0 instead of ``d_idx``."""
+
+    def __init__(self, names):
+        self.names = names
+
+    def visit_Subscript(self, node):
+        self.generic_visit(node)
+        if isinstance(node.value, ast.Name) and node.value.id in self.names:
+            node.slice = ast.copy_location(ast.Constant(0), node.slice)
+        return node
+
+
 def in_registers(spec, names):
     """A copy of ``spec`` where ``d_X[d_idx]`` reads/writes ``d_X[0]`` for X in names.
 
@@ -251,17 +258,8 @@ def in_registers(spec, names):
     so ``d_au[d_idx] += ...`` over all neighbours stays in a register instead of a
     load-add-store through memory per pair.
     """
-    import copy
-
-    class _Rewrite(ast.NodeTransformer):
-        def visit_Subscript(self, node):
-            self.generic_visit(node)
-            if isinstance(node.value, ast.Name) and node.value.id in names:
-                node.slice = ast.copy_location(ast.Constant(0), node.slice)
-            return node
-
     new = copy.copy(spec)
-    new.fdef = ast.fix_missing_locations(_Rewrite().visit(copy.deepcopy(spec.fdef)))
+    new.fdef = ast.fix_missing_locations(_RegisterForm(names).visit(copy.deepcopy(spec.fdef)))
     return new
 
 
@@ -348,71 +346,3 @@ def _declare_loop_counters(fdef):
     for d in decls:
         ast.copy_location(d, fdef)
     fdef.body = decls + fdef.body
-
-
-class _MarkedUnparser(ast._Unparser):
-    """Unparse with a ``# @src file:line`` comment before every statement."""
-
-    def __init__(self, filename):
-        super().__init__()
-        self._file = filename
-        self._pending = None
-
-    def traverse(self, node):
-        if isinstance(node, ast.stmt) and hasattr(node, "lineno") and not isinstance(node, ast.FunctionDef):
-            self._pending = node.lineno
-        super().traverse(node)
-
-    def fill(self, text=""):
-        if self._pending is not None:
-            self._source.append("\n" + "    " * self._indent + f"# @src {self._file}:{self._pending}")
-            self._pending = None
-        super().fill(text)
-
-
-def _arg_type(name, dtypes):
-    if name in ("d_idx", "s_idx"):
-        return "long"
-    if name in ("NBRS",):
-        return "int*"
-    if name in ("N_NBRS",):
-        return "long"
-    if name in VECTOR_SYMBOLS:
-        return "double*"
-    if name in PAIR_SYMBOLS or name in ("t", "dt"):
-        return "double"
-    if name.startswith(("d_", "s_")):
-        return dtypes.get(name, "double") + "*"
-    return None
-
-
-def to_cython(spec, dtypes=None, helper=False):
-    """Cython source of a specialised function, typed and ``noexcept nogil``."""
-    dtypes = dtypes or {}
-    fname = f"<sphgen:{spec.fdef.name}>"
-    src = _MarkedUnparser(spec.filename).visit(ast.Module(body=[spec.fdef], type_ignores=[]))
-    src = src.lstrip("\n") + "\n"
-    linecache.cache[fname] = (len(src), None, src.splitlines(True), fname)
-    namespace = {}
-    exec(compile(src, fname, "exec"), namespace)
-    func = namespace[spec.fdef.name]
-    known = {}
-    if not helper:
-        for a in spec.args:
-            t = _arg_type(a, dtypes)
-            if t is None:
-                raise TranslationError(
-                    f"argument '{a}' is neither a property (d_*/s_*), a pair symbol "
-                    f"({', '.join(PAIR_SYMBOLS)}) nor one of d_idx, s_idx, t, dt, NBRS, N_NBRS")
-            known[a] = KnownType(t)
-    gen = CythonGenerator(known_types=known)
-    try:
-        gen.parse(func)
-    except Exception as e:  # compyle raises a variety of errors
-        raise TranslationError(str(e)) from None
-    code = gen.get_code()
-    head, _, body = code.partition("\n")
-    head = head.replace("noexcept:", "noexcept nogil:")
-    if "nogil" not in head:
-        head = head.rstrip(":") + " nogil:"
-    return head + "\n" + body

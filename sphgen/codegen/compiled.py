@@ -1,0 +1,47 @@
+"""The compiled backend: the plan rendered, built (or loaded from the cache) and driven."""
+from .backend import Backend
+from .build import load_or_build
+from .render import render
+
+
+class CompiledBackend(Backend):
+    """One Cython/OpenMP module for the scene; entry points named by the renderer."""
+
+    name = "cython"
+
+    def __init__(self, plan, nnps):
+        super().__init__(plan, nnps)
+        self.rendered = render(plan)
+        self.source = self.rendered.source
+        self.module, self.compile_time = load_or_build(self.source, self.rendered.origin)
+        self.source_path = self.module.__sphgen_source__
+        self._passes = {k: getattr(self.module, v) for k, v in self.rendered.pass_entries.items()}
+        self._stages = {k: getattr(self.module, v) for k, v in self.rendered.stage_entries.items()}
+
+    def set_threads(self, n):
+        self.module.set_threads(n)
+
+    def bind(self, arrays):
+        self.module.bind_arrays({pa.name: (pa.n, {**pa.data, **pa.constants}) for pa in arrays})
+        self.module.set_parameters({g: float(getattr(o, a)) for g, (o, a) in self.rendered.parameters.items()})
+        self.bind_neighbours()
+
+    def bind_neighbours(self):
+        lists = {}
+        for key, (dest, src, reference) in self.rendered.neighbour_lists.items():
+            lists[key] = (self.nnps.reference_neighbours(dest, src) if reference
+                          else self.nnps.neighbours(dest, src))
+        self.module.bind_neighbours(lists)
+
+    def run_pass(self, npass, t, dt):
+        self._passes[npass.label](t, dt)
+
+    def run_stage(self, st, name, t, dt):
+        self._stages[(st.array, name)](t, dt)
+
+    def max_speed2(self, arrays):
+        return self.module.max_speed2()
+
+    def nonfinite_suspects(self, arrays):
+        by_name = {pa.name: pa for pa in arrays}
+        return [(by_name[a], p) for a, p, _ in self.module.count_nonfinite()]

@@ -1,0 +1,54 @@
+"""``--show-plan``: the plan as text, then what each pass removed or decided."""
+
+
+def _flags(group):
+    on = [f for f, v in (("iterate", group.iterate), ("update_nnps", group.update_nnps),
+                         ("reference", group.reference), ("condition", group.condition)) if v]
+    return f" [{', '.join(on)}]" if on else ""
+
+
+def _evaluations(plan):
+    lines = []
+    for i, row in enumerate(plan.group_plans):
+        lines.append(f"evaluation {i}:")
+        for gp in row:
+            lines.append(f"  group {gp.index}{_flags(gp.group)}:")
+            for dest, eps in gp.dests.items():
+                srcs = gp.sources(dest)
+                lines.append(f"    dest {dest}: one pass, neighbour sources: "
+                             f"{', '.join(srcs) if srcs else 'none'}")
+                lines += [f"      keep  {ep.name}: {', '.join(ep.methods)}" for ep in eps]
+            lines += [f"      prune {ep.name}: {ep.reason}" for ep in gp.eqplans if not ep.kept]
+    return lines
+
+
+def _allocation(plan):
+    lines = ["properties allocated:"]
+    for name, props in plan.allocation.items():
+        pa = plan.arrays[name]
+        lines.append(f"  {name} ({pa.n} particles): {', '.join(props)}")
+        declared = sorted(set(pa.props) - set(props))
+        if declared:
+            lines.append(f"    declared, not allocated: {', '.join(declared)}")
+    return lines
+
+
+def _passes(plan):
+    lines = ["passes:"]
+    for name, notes in plan.log:
+        lines.append(f"  {name}: {notes[0] if len(notes) == 1 else ('ok' if not notes else '')}".rstrip())
+        if len(notes) > 1:
+            lines += [f"    {n}" for n in notes]
+    return lines
+
+
+def describe(plan):
+    """Human-readable plan: evaluations, stages, allocation, then the passes' notes."""
+    dom = plan.domain
+    lines = [f"sphgen plan: dim={plan.dim}, kernel={type(plan.kernel).__name__}, "
+             f"periodic={tuple(dom.periodic) if dom else (False,) * 3}"]
+    lines += _evaluations(plan)
+    lines.append("integrator stages:")
+    lines += [f"  {st.array}: {type(st.stepper).__name__} {', '.join(st.stages)}" for st in plan.steppers]
+    lines += _allocation(plan) + _passes(plan)
+    return "\n".join(lines)
