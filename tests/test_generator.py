@@ -110,21 +110,20 @@ def test_loop_counters_are_declared_int_and_helpers_translate():
                 a[i] = d_A[9 * d_idx + i]
             d_d[d_idx] = det3(a)
 
-    if True:
-        res = {}
-        for backend in ("cython", "python"):
-            pa = lattice_cloud(nx=5)
-            rng = np.random.default_rng(0)
-            pa.add_property("A", stride=9, data=rng.uniform(-1, 1, 9 * pa.n))
-            pa.add_property("d")
-            sc = Scene([pa], [Det("fluid")], dim=2, outputs={"fluid": ["d"]}, backend=backend)
-            sc.compute(0, 0.0, 0.1)
-            res[backend] = pa.d.copy()
-            if backend == "cython":
-                assert "cdef int i" in sc.source and "det3(" in sc.source
-        expect = np.linalg.det(pa.A.reshape(-1, 3, 3))
-        assert np.allclose(res["cython"], expect, rtol=1e-12, atol=1e-14)
-        assert np.allclose(res["python"], expect, rtol=1e-12, atol=1e-14)
+    res = {}
+    for backend in ("cython", "python"):
+        pa = lattice_cloud(nx=5)
+        rng = np.random.default_rng(0)
+        pa.add_property("A", stride=9, data=rng.uniform(-1, 1, 9 * pa.n))
+        pa.add_property("d")
+        sc = Scene([pa], [Det("fluid")], dim=2, outputs={"fluid": ["d"]}, backend=backend)
+        sc.compute(0, 0.0, 0.1)
+        res[backend] = pa.d.copy()
+        if backend == "cython":
+            assert "cdef int i" in sc.source and "det3(" in sc.source
+    expect = np.linalg.det(pa.A.reshape(-1, 3, 3))
+    assert np.allclose(res["cython"], expect, rtol=1e-12, atol=1e-14)
+    assert np.allclose(res["python"], expect, rtol=1e-12, atol=1e-14)
 
 
 def test_pair_loop_accumulators_live_in_registers():
@@ -133,3 +132,13 @@ def test_pair_loop_accumulators_live_in_registers():
     src = sc.source
     assert "_r_au = fluid_au[d_idx]" in src and "fluid_au[d_idx] = _r_au" in src
     assert "&_r_au" in src and "d_au[0] +=" in src
+
+
+def test_show_plan_reports_every_pass_in_order():
+    from sphgen.codegen.passes import PASSES
+    text = _scene(["u", "omega"], alpha=0.5).describe()
+    lines = text[text.index("\npasses:\n"):].splitlines()
+    names = [ln.split(":")[0].strip() for ln in lines if ln.startswith("  ") and not ln.startswith("    ")]
+    assert names == [p.__name__ for p in PASSES]
+    assert "    g1_fluid: au, av, omega accumulated in registers" in text
+    assert "    g0_fluid <- fluid: XIJ, R2IJ, RIJ, HIJ, WIJ (~50 flops per pair)" in text

@@ -1,0 +1,71 @@
+"""Pass ``specialise``: switches, dimension and constants folded; nothing compiled."""
+import ast
+
+import pytest
+
+from sphgen.codegen import passes
+from sphgen.codegen.plan import SceneError, new_plan
+from sphgen.equation import Equation
+from sphgen.equations.momentum import ArtificialViscosity
+from sphgen.integrators import IntegratorStep
+from sphgen.kernels import QuinticSpline
+
+from conftest import lattice_cloud
+
+
+class Dot(Equation):
+    def loop(self, d_idx, d_s, s_idx, XIJ, DWIJ):
+        d_s[d_idx] += XIJ[0] * DWIJ[0] + XIJ[1] * DWIJ[1] + XIJ[2] * DWIJ[2]
+
+
+class Scatter(Equation):
+    def loop(self, d_idx, s_idx, s_rho, WIJ):
+        s_rho[s_idx] += WIJ
+
+
+class Step(IntegratorStep):
+    def stage1(self, d_idx, d_x, d_u, dt):
+        d_x[d_idx] += dt * d_u[d_idx]
+
+    def stage2(self, d_idx):
+        pass
+
+
+def _specialised(equations, dim=2, steppers=None):
+    pa = lattice_cloud(nx=3, dim=dim)
+    pa.add_property("s")
+    plan = new_plan([pa], equations, steppers, QuinticSpline(dim), dim)
+    return plan, passes.specialise(plan)
+
+
+def test_dimension_folds_the_third_component_away():
+    plan, _ = _specialised([Dot("fluid", ["fluid"])])
+    assert ast.unparse(plan.eqplans[0].methods["loop"].fdef) == (
+        "def Dot_0_loop(d_idx, d_s, XIJ, DWIJ):\n"
+        "    d_s[d_idx] += XIJ[0] * DWIJ[0] + XIJ[1] * DWIJ[1]")   # and s_idx, now unused, is gone
+    plan3, _ = _specialised([Dot("fluid", ["fluid"])], dim=3)
+    assert "XIJ[2] * DWIJ[2]" in ast.unparse(plan3.eqplans[0].methods["loop"].fdef)
+
+
+def test_a_zero_switch_drops_the_equation_and_a_nonzero_float_stays_a_parameter():
+    plan, notes = _specialised([ArtificialViscosity("fluid", ["fluid"], alpha=0.0, c0=10.0)])
+    ep = plan.eqplans[0]
+    assert (ep.kept, ep.methods, ep.reason) == (False, {}, "switched off (alpha=0.0)")
+    assert "drop ArtificialViscosity[fluid<-fluid]: switched off (alpha=0.0)" in notes
+    plan, _ = _specialised([ArtificialViscosity("fluid", ["fluid"], alpha=0.5, c0=10.0)])
+    src = ast.unparse(plan.eqplans[0].methods["loop"].fdef)
+    assert "-ArtificialViscosity_0_alpha * ArtificialViscosity_0_c0 * phi" in src and "self" not in src
+    assert plan.eqplans[0].methods["loop"].params_used == {"alpha", "c0"}
+
+
+def test_pair_loops_must_be_gather_only():
+    with pytest.raises(SceneError, match=r"Scatter\[fluid<-fluid\]\.loop writes s_rho: pair loops"):
+        _specialised([Scatter("fluid", ["fluid"])])
+
+
+def test_stage_methods_are_specialised_and_empty_ones_dropped():
+    plan, notes = _specialised([], steppers={"fluid": Step()})
+    (st,) = plan.steppers
+    assert list(st.stages) == ["stage1"]
+    assert ast.unparse(st.stages["stage1"].fdef).startswith("def Step_0_stage1(d_idx, d_x, d_u, dt):")
+    assert notes == ["1 methods specialised for dim=2"]
