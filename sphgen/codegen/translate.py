@@ -13,6 +13,7 @@ import copy
 import inspect
 import textwrap
 import types
+from dataclasses import dataclass
 
 from ..errors import SphgenError
 from . import pair_symbols
@@ -196,18 +197,20 @@ def _is_empty(body):
                for s in body)
 
 
+@dataclass(eq=False)
 class Specialised:
     """A method after specialisation: its AST, arguments, and property usage."""
 
-    def __init__(self, owner, method, fdef, params_used, filename, firstline):
-        self.owner = owner
-        self.method = method
-        self.fdef = fdef
-        self.params_used = params_used
-        self.filename = filename
-        self.firstline = firstline
-        self.args = [a.arg for a in fdef.args.args]
-        self.reads, self.writes = _usage(fdef)
+    owner: object
+    method: str
+    fdef: ast.FunctionDef
+    params_used: set           # parameters read as module globals
+    filename: str
+    firstline: int
+
+    def __post_init__(self):
+        self.args = [a.arg for a in self.fdef.args.args]
+        self.reads, self.writes = _usage(self.fdef)
 
     @property
     def empty(self):
