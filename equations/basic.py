@@ -3,7 +3,7 @@ from sphgen.equation import Equation
 
 
 class SummationDensity(Equation):
-    """rho_a = sum_b m_b W_ab (seed 002 section 2.3, option 1)."""
+    """rho_a = sum_b m_b W_ab (Adepu & Ramachandran (2024), sec. 2.3, option 1)."""
 
     def initialize(self, d_idx, d_rho):
         d_rho[d_idx] = 0.0

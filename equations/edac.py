@@ -3,8 +3,8 @@ from sphgen.equation import Equation
 
 
 class EDACPressureRate(Equation):
-    """dp/dt = -rho c^2 div(u) + nu_edac lap(p) (seed 002 eq. 22, discretised as eq. 26
-    without the CTVF corrections; damping in the consistent form, digest A3).
+    """dp/dt = -rho c^2 div(u) + nu_edac lap(p) (Adepu & Ramachandran (2024), eq. 22, as eq. 26
+    without the CTVF corrections; damping in the consistent form: eq. 26 has an extra 1/rho).
 
     div(u)_a = -sum_b V_b u_ab . grad W_ab; the Laplacian is
     sum_b V_b 4 rho_a (p_a - p_b) r_ab . grad W_ab / ((rho_a + rho_b)(r^2 + 0.01 h^2)).

@@ -19,7 +19,7 @@ class AveragePressure(Equation):
 
 
 class PressureGradient(Equation):
-    """du_a/dt = -sum_b m_b (p_a/rho_a^2 + p_b/rho_b^2) grad W_ab (seed 002 eq. 27, first term).
+    """du_a/dt = -sum_b m_b (p_a/rho_a^2 + p_b/rho_b^2) grad W_ab (Adepu & Ramachandran (2024), eq. 27).
 
     With ``bql`` the destination's local mean pressure p_avg,a is subtracted from p_a
     and p_b (Basa, Quinlan & Lastiwka 2009), which removes the tensile instability of
@@ -49,7 +49,7 @@ class PressureGradient(Equation):
 
 class LaminarViscosity(Equation):
     """du_a/dt += sum_b m_b 4 nu (r_ab . grad W_ab) u_ab / ((rho_a + rho_b)(r^2 + 0.01 h^2))
-    (Morris et al. 1997; seed 002 eq. 27, third term)."""
+    (Morris et al. 1997; Adepu & Ramachandran (2024), eq. 27, third term)."""
 
     nonnegative = ("nu",)
     switches = ("nu",)
@@ -65,8 +65,8 @@ class LaminarViscosity(Equation):
 
 class ArtificialViscosity(Equation):
     """du_a/dt -= sum_b m_b Pi_ab grad W_ab, Pi_ab = -alpha h c phi_ab / rho_ab for
-    u_ab . r_ab < 0 (Monaghan; seed 002 eqs. 28-29).  ``alpha`` is a switch: with
-    alpha = 0 the equation vanishes from the generated code."""
+    u_ab . r_ab < 0 (Monaghan; Adepu & Ramachandran (2024), eqs. 28-29).  ``alpha`` is a
+    switch: with alpha = 0 the equation vanishes from the generated code."""
 
     switches = ("alpha",)
     nonnegative = ("alpha", "c0")

@@ -5,9 +5,9 @@ from sphgen.equation import Equation
 
 
 class TimeStepLimits(Equation):
-    """dt_cfl = h/(c0 + |u|), dt_visc = h^2/nu, dt_force = sqrt(h/|a|) (seed 002 eq. 61
-    without its 0.25 safety factors, which the solver's ``cfl`` applies).  Place it
-    after the momentum equations; the solver takes ``cfl * min`` over all particles."""
+    """dt_cfl = h/(c0 + |u|), dt_visc = h^2/nu, dt_force = sqrt(h/|a|) (Adepu & Ramachandran
+    (2024), eq. 61, without its 0.25 safety factors, which the solver's ``cfl`` applies).
+    Place it after the momentum equations; the solver takes ``cfl * min`` over all particles."""
 
     positive = ("c0",)
     nonnegative = ("nu",)

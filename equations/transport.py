@@ -4,7 +4,7 @@ from sphgen.equation import Equation
 
 class SunShiftingAcceleration(Equation):
     """(du/dt)_c = -Ma (2h) c0 / dt sum_b [1 + R (W_ab / W(dx))^n] grad W_ab V_b
-    (SPST, seed 002 eq. 36; R = 0.2, n = 4)."""
+    (SPST; Adepu & Ramachandran (2024), eq. 36; R = 0.2, n = 4)."""
 
     positive = ("mach", "c0", "wdx")
 
@@ -25,7 +25,7 @@ class SunShiftingAcceleration(Equation):
 
 class TransportStress(Equation):
     """du_a/dt += sum_b m_b (u_a (x) delta_a / rho_a + u_b (x) delta_b / rho_b) . grad W_ab,
-    delta = u~ - u (the TVF 'A' term kept by the uncorrected baseline; seed 002 eq. 27)."""
+    delta = u~ - u (the TVF 'A' term of the uncorrected baseline; Adepu & Ramachandran (2024), eq. 27)."""
 
     def loop(self, d_idx, d_au, d_av, d_aw, d_u, d_v, d_w, d_uhat, d_vhat, d_what, d_rho,
              s_idx, s_m, s_u, s_v, s_w, s_uhat, s_vhat, s_what, s_rho, DWIJ):
@@ -47,7 +47,7 @@ class TransportStress(Equation):
 
 class BackgroundPressureAcceleration(Equation):
     """(du/dt)_c = -p_b sum_b m_b (1/rho_a^2 + 1/rho_b^2) grad W_ab: the TVF homogenisation
-    of seed 002 eq. 20 in the symmetric form of Adami et al. 2013 (eq. 13)."""
+    of Adepu & Ramachandran (2024), eq. 20, in the symmetric form of Adami et al. 2013 (eq. 13)."""
 
     positive = ("pb",)
 

@@ -1,11 +1,11 @@
-"""Weakly compressible EDAC scheme: the uncorrected baseline of seed 002 (sections 2-3).
+"""Weakly compressible EDAC: the uncorrected baseline of Adepu & Ramachandran (2024), secs. 2-3.
 
 Summation density, EDAC pressure (eq. 22 discretised as eq. 26 without the CTVF
 corrections), momentum with pressure gradient, Morris viscosity and optional
 artificial viscosity (eqs. 27-29), kick-drift-kick integration (eqs. 54-60).  With
 ``pst='sun2019'`` particles move with the transport velocity u~ = u + dt/2 (du/dt)_c
 of the Sun et al. shifting acceleration (eq. 36, 55) and the momentum equation keeps
-the TVF stress term; the corrections C1-C3 of CTVF are not applied (digest A10).
+the TVF stress term; the corrections C1-C3 of CTVF are not applied.
 """
 from sphgen.equation import Group
 from sphgen.integrators import IntegratorStep, KickDriftKick
@@ -26,7 +26,7 @@ PSTS = ("none", "sun2019", "tvf")
 
 
 class EDACStep(IntegratorStep):
-    """Kick-drift-kick stages of seed 002 eqs. 54-60 (``shift``: move with u~)."""
+    """Kick-drift-kick stages of Adepu & Ramachandran (2024), eqs. 54-60 (``shift``: move with u~)."""
 
     switches = ("dim", "shift")
 
@@ -69,7 +69,7 @@ class EDACStep(IntegratorStep):
 
 
 class EDACScheme(Scheme):
-    """EDAC, seed 002 uncorrected baseline, with optional Adami walls and body force.
+    """EDAC, Adepu & Ramachandran (2024) uncorrected baseline, with optional Adami walls and body force.
 
     Walls (``walls``: array names, fixed particles with ``m``, ``h``, ``rho``): every
     evaluation of the momentum equation first gives them the pressure extrapolated from
@@ -190,7 +190,7 @@ class EDACScheme(Scheme):
         return {f: (0.2 * self.rho0, 3.0 * self.rho0) for f in self.fluids}
 
     def get_timestep(self):
-        """Seed 002 eq. 61: min(0.25 h/(c0 + U), 0.25 h^2/nu)."""
+        """Adepu & Ramachandran (2024), eq. 61: min(0.25 h/(c0 + U), 0.25 h^2/nu)."""
         dt = 0.25 * self.h / (self.c0 + self.umax)
         if self.nu > 0:
             dt = min(dt, 0.25 * self.h * self.h / self.nu)

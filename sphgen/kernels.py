@@ -29,7 +29,7 @@ class Kernel:
 
 
 class QuinticSpline(Kernel):
-    """Quintic spline, support 3h (seed 002 section 2.2; Morris et al. 1997)."""
+    """Quintic spline, support 3h (Adepu & Ramachandran (2024), sec. 2.2; Morris et al. 1997)."""
 
     radius_scale = 3.0
     name = "quintic"
