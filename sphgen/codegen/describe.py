@@ -34,11 +34,13 @@ def _allocation(plan):
 
 
 def _passes(plan):
+    """One line per pass: its note, 'ok' without one, or its notes indented below it."""
     lines = ["passes:"]
     for name, notes in plan.log:
-        lines.append(f"  {name}: {notes[0] if len(notes) == 1 else ('ok' if not notes else '')}".rstrip())
-        if len(notes) > 1:
-            lines += [f"    {n}" for n in notes]
+        if len(notes) <= 1:
+            lines.append(f"  {name}: {notes[0] if notes else 'ok'}")
+        else:
+            lines += [f"  {name}:"] + [f"    {n}" for n in notes]
     return lines
 
 

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from ..equation import Equation, Group
 from ..errors import SphgenError
 from . import pair_symbols
+from .describe import describe
 from .pair_symbols import PairGeometry
 
 
@@ -229,7 +230,6 @@ class Plan:
 
     def describe(self):
         """Human-readable plan (``--show-plan``)."""
-        from .describe import describe
         return describe(self)
 
 
