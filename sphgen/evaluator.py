@@ -41,9 +41,9 @@ class PythonEvaluator(Backend):
             self._scratch[key] = np.zeros(pa.n * pa.props[name].stride, dtype=pa.props[name].np_dtype)
         return self._scratch[key]
 
-    def _call(self, ep, method, dest, src, i, j=None, sym=None, t=0.0, dt=0.0, nbrs=None):
+    def _call(self, owner, method, dest, src, i, j=None, sym=None, t=0.0, dt=0.0, nbrs=None):
         """Call a method of an equation (or stepper) with arguments found by name."""
-        f = getattr(ep, method)
+        f = getattr(owner, method)
         special = {"d_idx": i, "s_idx": j, "t": t, "dt": dt, "NBRS": nbrs,
                    "N_NBRS": None if nbrs is None else len(nbrs)}
         kw = {}
