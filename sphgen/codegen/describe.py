@@ -26,7 +26,7 @@ def _allocation(plan):
     lines = ["properties allocated:"]
     for name, props in plan.allocation.items():
         pa = plan.arrays[name]
-        lines.append(f"  {name} ({pa.n} particles): {', '.join(props)}")
+        lines.append(f"  {name} ({pa.n} particles): {', '.join(sorted(props))}")
         declared = sorted(set(pa.props) - set(props))
         if declared:
             lines.append(f"    declared, not allocated: {', '.join(declared)}")

@@ -207,7 +207,7 @@ class Plan:
     outputs: dict = field(default_factory=dict)
     needed: set = field(default_factory=set)          # (array, prop) something needs
     group_plans: list = field(default_factory=list)   # per evaluation: [GroupPlan]
-    allocation: dict = field(default_factory=dict)    # array -> {prop: C type}
+    allocation: dict = field(default_factory=dict)    # array -> {props given memory}
     kernel_functions: list = field(default_factory=list)
     functions: list = field(default_factory=list)     # FunctionPlans, in emission order
     helpers: list = field(default_factory=list)       # Specialised helpers, callees first

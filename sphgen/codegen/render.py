@@ -122,7 +122,7 @@ def _method_code(fp):
 
 def _array_tables(plan):
     """What the module's data, guard and speed sections list, array by array."""
-    alloc = plan.allocation.items()
+    alloc = [(name, {p: plan.dtype(name, p) for p in sorted(props)}) for name, props in plan.allocation.items()]
     moving = [(name, [u for u in ("u", "v", "w")[:plan.dim] if u in props]) for name, props in alloc
               if "u" in props]
     return dict(

@@ -14,8 +14,7 @@ def allocate(plan):
     for st in plan.steppers:
         for sp in st.stages.values():
             alloc[st.array] |= {a[2:] for a in sp.args if is_property(a, "d_")}
-    plan.allocation = {name: {p: plan.dtype(name, p) for p in sorted(props - set(plan.arrays[name].constants))}
-                       for name, props in alloc.items()}
+    plan.allocation = {name: props - set(plan.arrays[name].constants) for name, props in alloc.items()}
     notes = []
     for name, props in plan.allocation.items():
         spare = sorted(set(plan.arrays[name].props) - set(props))
