@@ -2,7 +2,7 @@
 
 Generalised wall boundary of Adami, Hu & Adams (2012, J. Comput. Phys. 231, 7057; "AHA"
 below) and two repulsive-force walls (Monaghan & Kajtar 2009; the Lennard-Jones-type
-force of da Silva & Giraldi, seed 004 eq. 58).
+force of da Silva & Giraldi (2024), eq. 58).
 
 Wall arrays are fixed layers of particles with ``m`` (= rho0 dx^dim), ``h``, and the
 properties these equations compute: ``p``, ``rho``, ``wij`` (the Shepard sum) and, for
@@ -277,7 +277,7 @@ class WallArtificialViscosity(Equation):
 
 
 class WallEDACPressureRate(Equation):
-    """The wall part of the EDAC pressure equation (seed 002 eq. 22/26 with AHA walls):
+    """Wall part of the EDAC pressure equation (Adepu & Ramachandran (2024), eq. 22/26, AHA walls):
     dp_a/dt += sum_w V_w [rho_a c0^2 (u_a - u_w) . grad W_aw
     + 4 nu_edac rho_a (p_a - p_w) r_aw . grad W_aw / ((rho_a + rho_w)(r^2 + 0.01 h^2))],
     V_w = m_w/rho_w, u_w the prescribed wall velocity (dest: a fluid, sources: walls)."""
@@ -335,7 +335,7 @@ class MonaghanKajtarForce(Equation):
 
 
 class LennardJonesWallForce(Equation):
-    """Wall force of da Silva & Giraldi (seed 004 eq. 58), a Lennard-Jones-type repulsion:
+    """Wall force of da Silva & Giraldi (2024), eq. 58, a Lennard-Jones-type repulsion:
     a_a += sum_g D [(r0/r)^n1 - (r0/r)^n2] x_ag / r^power for r < r0, n1 = 12, n2 = 4;
     ``power`` = 1 (unit vector, as printed) or 2 (Monaghan 1994 / Liu & Liu).
     dest: a fluid, sources: boundary particles (no other property needed)."""
