@@ -4,7 +4,7 @@ import re
 import numpy as np
 import pytest
 
-from sphgen.codegen.plan import Plan, normalise_stages
+from sphgen.codegen.passes import plan_scene
 from sphgen.codegen.render import render
 from sphgen.equation import Group
 from sphgen.equations.walls import (LennardJonesWallForce, MonaghanKajtarForce, WallArtificialViscosity,
@@ -157,8 +157,8 @@ def test_repulsive_forces_push_away_from_the_wall_and_vanish_far_from_it():
 
 def rendered(eqs, arrays, outputs):
     """Generated Cython source of a scene, without compiling it."""
-    plan = Plan(arrays, normalise_stages(eqs), {}, QuinticSpline(2), 2, None, outputs)
-    return render(plan)[0], plan
+    plan = plan_scene(arrays, eqs, {}, QuinticSpline(2), 2, None, outputs)
+    return render(plan).source, plan
 
 
 def test_wall_at_rest_has_no_velocity_arrays_in_the_generated_code():

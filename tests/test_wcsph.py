@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from sphgen.app import load_application
-from sphgen.codegen.plan import Plan, normalise_stages
+from sphgen.codegen.passes import plan_scene
 from sphgen.codegen.render import render
 from sphgen.equation import Group
 from sphgen.equations.wcsph import DensityDiffusion, RenormalisedDensityGradient
@@ -85,9 +85,9 @@ def plan_and_source(**kw):
     arrays = tank()
     s = WCSPHScheme(["fluid"], ["wall"], 2, RHO0, 20.0, DX, gy=-9.81, **kw)
     s.setup_properties(arrays)
-    plan = Plan(arrays, normalise_stages(s.get_equations()), s.get_integrator().steppers, s.kernel, 2, None,
-                {pa.name: [p for p in s.output_props if pa.has(p)] for pa in arrays[:2]})
-    return plan, render(plan)[0]
+    plan = plan_scene(arrays, s.get_equations(), s.get_integrator().steppers, s.kernel, 2, None,
+                      {pa.name: [p for p in s.output_props if pa.has(p)] for pa in arrays[:2]})
+    return plan, render(plan).source
 
 
 def test_delta_zero_removes_density_diffusion_from_the_generated_code():
