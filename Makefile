@@ -4,7 +4,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: run test test-slow bench docs clean
+.PHONY: run test test-slow bench docs clean pysph
 
 $(STAMP): setup.py pyproject.toml $(wildcard sphgen/nnps/*.pyx)
 	$(PYTHON) -m venv $(VENV)
@@ -23,6 +23,11 @@ test-slow: $(STAMP)
 
 bench: $(STAMP)
 	$(PY) benchmarks/bench_taylor_green.py
+
+# PySPH 1.0b2 in its own venv, for the benchmarks' same-case comparisons (not a dependency)
+pysph:
+	$(PYTHON) -m venv .pysph-venv
+	.pysph-venv/bin/pip install --quiet pysph "numpy<2.4"
 
 docs: $(STAMP)
 	$(PY) -m pip install --quiet sphinx
