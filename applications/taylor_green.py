@@ -4,6 +4,11 @@ u = -U e^{bt} cos(2 pi x) sin(2 pi y), v = U e^{bt} sin(2 pi x) cos(2 pi y),
 p = -U^2 e^{2bt} (cos(4 pi x) + cos(4 pi y)) / 4, b = -8 pi^2 / Re.
 ``post_process`` writes results.json (L1 error of |u|, seed 002 eq. 66; max |u| and
 its exact decay) and a plot of both over time.
+
+``--scheme`` picks EDAC (the default; the uncorrected baseline), CTVF (Adepu &
+Ramachandran 2021) or GTVF (Zhang, Hu & Adams 2017); ``--shifting`` the homogenisation
+independently of the scheme (SPST, IPST, GTVF, TVF or none); ``--no-corrections`` (or
+one ``--no-*-correction`` flag per term) the CTVF runs without corrections.
 """
 import json
 import os
@@ -17,7 +22,14 @@ from sphgen.errors import InputError
 from sphgen.nnps import Domain
 from sphgen.particles import ParticleArray
 
+from ..equations.shifting import SHIFTINGS
+from ..schemes.ctvf import CTVFScheme
 from ..schemes.edac import PSTS, EDACScheme
+from ..schemes.gtvf import GTVFScheme
+
+SCHEMES = ("edac", "ctvf", "gtvf")
+# --shifting for the EDAC scheme, in its own names
+EDAC_SHIFTING = {"spst": "sun2019", "tvf": "tvf", "none": "none"}
 
 
 def exact_velocity(x, y, t, re, U=1.0):
@@ -35,7 +47,7 @@ def l1_error(x, y, u, v, t, re):
 
 
 class TaylorGreen(Application):
-    """Taylor-Green vortex, EDAC scheme, periodic unit box."""
+    """Taylor-Green vortex, periodic unit box: EDAC, CTVF or GTVF scheme."""
 
     tf = 0.5
     pfreq = 200
@@ -49,15 +61,40 @@ class TaylorGreen(Application):
         group.add_argument("--nx", type=int, default=50, help="particles per side (default %(default)s)")
         group.add_argument("--re", type=float, default=100.0, help="Reynolds number (default %(default)s)")
         group.add_argument("--hdx", type=float, default=1.0, help="h / dx (default %(default)s)")
+        group.add_argument("--scheme", choices=SCHEMES, default="edac",
+                           help="EDAC (uncorrected baseline), CTVF (Adepu & Ramachandran 2021) or "
+                           "GTVF (Zhang, Hu & Adams 2017) (default %(default)s)")
         group.add_argument("--pst", choices=PSTS, default="sun2019",
-                           help="particle shifting (default %(default)s)")
+                           help="particle shifting of the EDAC scheme (default %(default)s); "
+                           "--shifting overrides it")
+        group.add_argument("--shifting", choices=SHIFTINGS, default=None,
+                           help="homogenisation, for any scheme: spst (Sun et al. 2019), ipst "
+                           "(Huang et al. 2019), gtvf (Zhang et al. 2017), tvf (background pressure), "
+                           "none (default: spst for ctvf, gtvf for gtvf, --pst for edac)")
+        group.add_argument("--no-corrections", action="store_true",
+                           help="ctvf: switch off every correction term (EDAC, stress, divergence)")
+        for term, what in (("edac", "the transport terms of the EDAC pressure equation (eq. 26)"),
+                           ("stress", "the momentum term div(u (x) (u~ - u))"),
+                           ("divergence", "the momentum term -u div(u~ - u)")):
+            group.add_argument(f"--no-{term}-correction", action="store_true", help=f"ctvf: without {what}")
+        group.add_argument("--density", choices=("summation", "continuity"), default=None,
+                           help="ctvf/gtvf: summation density, or continuity with u~ (default: "
+                           "summation for ctvf, continuity for gtvf)")
+        group.add_argument("--ipst-interval", type=int, default=1,
+                           help="ipst: shift every k-th step (default %(default)s)")
+        group.add_argument("--ipst-max-iterations", type=int, default=10,
+                           help="ipst: iteration cap (default %(default)s)")
+        group.add_argument("--ipst-tolerance", type=float, default=0.02,
+                           help="ipst: |max chi - chi_ref| tolerance (default %(default)s)")
         group.add_argument("--c0", type=float, default=10.0, help="artificial sound speed (default 10 U)")
         group.add_argument("--perturb", type=float, default=0.0,
                            help="random lattice perturbation in units of dx (default 0)")
         group.add_argument("--seed", type=int, default=1, help="seed of the perturbation (default 1)")
-        group.add_argument("--no-bql", dest="bql", action="store_false",
+        group.add_argument("--no-bql", dest="bql", action="store_false", default=None,
                            help="no local mean pressure in the pressure gradient: the pair force is "
-                           "then antisymmetric and momentum is conserved to round-off")
+                           "then antisymmetric and momentum is conserved to round-off ")
+        group.add_argument("--bql", dest="bql", action="store_true", default=None,
+                           help="subtract the local mean pressure (Basa et al. 2009; the default for edac and ctvf)")
         group.add_argument("--output-vorticity", action="store_true",
                            help="also compute and write the vorticity 'omega'")
 
@@ -70,6 +107,16 @@ class TaylorGreen(Application):
                 raise InputError(f"--{name} must be a positive finite number, got {v}")
         if not (np.isfinite(o.perturb) and 0 <= o.perturb < 0.5):
             raise InputError(f"--perturb must be in [0, 0.5), got {o.perturb}")
+        for name in ("ipst_interval", "ipst_max_iterations"):
+            if getattr(o, name) < 1:
+                raise InputError(f"--{name.replace('_', '-')} must be at least 1, got {getattr(o, name)}")
+        if not (np.isfinite(o.ipst_tolerance) and o.ipst_tolerance > 0):
+            raise InputError(f"--ipst-tolerance must be a positive finite number, got {o.ipst_tolerance}")
+        if o.scheme == "edac" and o.shifting is not None and o.shifting not in EDAC_SHIFTING:
+            raise InputError(f"--shifting {o.shifting} is not available with --scheme edac "
+                             f"(choose from {', '.join(EDAC_SHIFTING)})")
+        if o.scheme == "gtvf" and o.bql:
+            raise InputError("--bql is not part of the GTVF scheme")
         self.nx, self.re = o.nx, o.re
         self.dx = 1.0 / o.nx
         self.h = o.hdx * self.dx
@@ -93,9 +140,24 @@ class TaylorGreen(Application):
         return Domain(0.0, 1.0, 0.0, 1.0, periodic_in_x=True, periodic_in_y=True)
 
     def create_scheme(self):
-        s = EDACScheme(["fluid"], dim=2, rho0=1.0, c0=self.options.c0, nu=self.nu, h=self.h,
-                       dx=self.dx, umax=1.0, pst=self.options.pst, bql=self.options.bql)
-        if self.options.output_vorticity:
+        o = self.options
+        common = dict(dim=2, rho0=1.0, c0=o.c0, nu=self.nu, h=self.h, dx=self.dx, umax=1.0)
+        ipst = dict(ipst_interval=o.ipst_interval, ipst_max_iterations=o.ipst_max_iterations,
+                    ipst_tolerance=o.ipst_tolerance)
+        if o.scheme == "edac":
+            pst = o.pst if o.shifting is None else EDAC_SHIFTING[o.shifting]
+            s = EDACScheme(["fluid"], pst=pst, bql=True if o.bql is None else o.bql, **common)
+        elif o.scheme == "ctvf":
+            off = {"edac", "stress", "divergence"} if o.no_corrections else set()
+            off |= {t for t in ("edac", "stress", "divergence") if getattr(o, f"no_{t}_correction")}
+            corrections = tuple(c for c in ("edac", "stress", "divergence", "continuity") if c not in off)
+            s = CTVFScheme(["fluid"], shifting=o.shifting or "spst", corrections=corrections,
+                           density=o.density or "summation", bql=True if o.bql is None else o.bql,
+                           **common, **ipst)
+        else:
+            s = GTVFScheme(["fluid"], shifting=o.shifting or "gtvf", density=o.density or "continuity",
+                           **common, **ipst)
+        if o.output_vorticity:
             s.output_props = s.output_props + ("omega",)
         return s
 
@@ -143,7 +205,7 @@ class TaylorGreen(Application):
                    "energy_error": float(np.abs(ke / ke_exact - 1.0).max()),
                    "max_density_error": float(drho.max())}
         io.write_json(os.path.join(outdir, "results.json"), results)
-        self.plot(outdir, t, umax, uex, l1)
+        self.plot(outdir, t, umax, uex, l1, label=f"sphgen {getattr(getattr(self, 'options', None), 'scheme', 'edac').upper()}")
         print(f"taylor_green: t={results['t']:.4g}  L1(|u|)={results['l1_error']:.4f} "
               f"(time mean {results['l1_error_mean']:.4f})  "
               f"max|u|={results['max_u']:.5f} (exact {results['max_u_exact']:.5f}, "
@@ -152,13 +214,13 @@ class TaylorGreen(Application):
         return results
 
     @staticmethod
-    def plot(outdir, t, umax, uex, l1):
+    def plot(outdir, t, umax, uex, l1, label="sphgen"):
         import matplotlib
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
         fig, (a, b) = plt.subplots(1, 2, figsize=(10, 4))
         a.semilogy(t, uex, "k-", label="exact $e^{-8\\pi^2 t/Re}$")
-        a.semilogy(t, umax, "r--", label="sphgen EDAC")
+        a.semilogy(t, umax, "r--", label=label)
         a.set_xlabel("t")
         a.set_ylabel("max |u|")
         a.legend()

@@ -1,65 +1,56 @@
-"""Transport velocity: particle shifting written as an acceleration, and the TVF stress."""
+"""Transport-velocity pieces: the TVF stress term and the continuity equation with u~.
+
+Particles move with the transport velocity u~ = u + delta (``uhat, vhat, what``); the
+homogenisation accelerations that make delta live in :mod:`sphgen.equations.shifting`
+(re-exported here for the schemes that imported them from this module).
+"""
 from sphgen.equation import Equation
 
-
-class SunShiftingAcceleration(Equation):
-    """(du/dt)_c = -Ma (2h) c0 / dt sum_b [1 + R (W_ab / W(dx))^n] grad W_ab V_b
-    (SPST; Adepu & Ramachandran (2024), eq. 36; R = 0.2, n = 4)."""
-
-    positive = ("mach", "c0", "wdx")
-
-    def initialize(self, d_idx, d_auhat, d_avhat, d_awhat):
-        d_auhat[d_idx] = 0.0
-        d_avhat[d_idx] = 0.0
-        d_awhat[d_idx] = 0.0
-
-    def loop(self, d_idx, d_auhat, d_avhat, d_awhat, d_h, s_idx, s_m, s_rho, WIJ, DWIJ, dt):
-        ratio = WIJ / self.wdx
-        ratio2 = ratio * ratio
-        fac = -self.mach * 2.0 * d_h[d_idx] * self.c0 / dt * (1.0 + 0.2 * ratio2 * ratio2)
-        vb = s_m[s_idx] / s_rho[s_idx]
-        d_auhat[d_idx] += fac * vb * DWIJ[0]
-        d_avhat[d_idx] += fac * vb * DWIJ[1]
-        d_awhat[d_idx] += fac * vb * DWIJ[2]
+from .shifting import BackgroundPressureAcceleration, SunShiftingAcceleration  # noqa: F401
 
 
 class TransportStress(Equation):
     """du_a/dt += sum_b m_b (u_a (x) delta_a / rho_a + u_b (x) delta_b / rho_b) . grad W_ab,
-    delta = u~ - u (the TVF 'A' term of the uncorrected baseline; Adepu & Ramachandran (2024), eq. 27)."""
+    delta = u~ - u: the divergence of u (x) (u~ - u), the TVF 'A' term (Adami, Hu & Adams
+    2013, eq. 9; Adepu & Ramachandran 2021, eq. 27).  ``enabled`` is a switch: False
+    removes it from the generated code (the CTVF runs without corrections)."""
+
+    switches = ("enabled",)
+
+    def __init__(self, dest, sources, enabled=True):
+        super().__init__(dest, sources, enabled=bool(enabled))
 
     def loop(self, d_idx, d_au, d_av, d_aw, d_u, d_v, d_w, d_uhat, d_vhat, d_what, d_rho,
              s_idx, s_m, s_u, s_v, s_w, s_uhat, s_vhat, s_what, s_rho, DWIJ):
-        dxa = d_uhat[d_idx] - d_u[d_idx]
-        dya = d_vhat[d_idx] - d_v[d_idx]
-        dza = d_what[d_idx] - d_w[d_idx]
-        dxb = s_uhat[s_idx] - s_u[s_idx]
-        dyb = s_vhat[s_idx] - s_v[s_idx]
-        dzb = s_what[s_idx] - s_w[s_idx]
-        ra = 1.0 / d_rho[d_idx]
-        rb = 1.0 / s_rho[s_idx]
-        dda = (dxa * DWIJ[0] + dya * DWIJ[1] + dza * DWIJ[2]) * ra
-        ddb = (dxb * DWIJ[0] + dyb * DWIJ[1] + dzb * DWIJ[2]) * rb
-        mb = s_m[s_idx]
-        d_au[d_idx] += mb * (d_u[d_idx] * dda + s_u[s_idx] * ddb)
-        d_av[d_idx] += mb * (d_v[d_idx] * dda + s_v[s_idx] * ddb)
-        d_aw[d_idx] += mb * (d_w[d_idx] * dda + s_w[s_idx] * ddb)
+        if self.enabled:
+            dxa = d_uhat[d_idx] - d_u[d_idx]
+            dya = d_vhat[d_idx] - d_v[d_idx]
+            dza = d_what[d_idx] - d_w[d_idx]
+            dxb = s_uhat[s_idx] - s_u[s_idx]
+            dyb = s_vhat[s_idx] - s_v[s_idx]
+            dzb = s_what[s_idx] - s_w[s_idx]
+            ra = 1.0 / d_rho[d_idx]
+            rb = 1.0 / s_rho[s_idx]
+            dda = (dxa * DWIJ[0] + dya * DWIJ[1] + dza * DWIJ[2]) * ra
+            ddb = (dxb * DWIJ[0] + dyb * DWIJ[1] + dzb * DWIJ[2]) * rb
+            mb = s_m[s_idx]
+            d_au[d_idx] += mb * (d_u[d_idx] * dda + s_u[s_idx] * ddb)
+            d_av[d_idx] += mb * (d_v[d_idx] * dda + s_v[s_idx] * ddb)
+            d_aw[d_idx] += mb * (d_w[d_idx] * dda + s_w[s_idx] * ddb)
 
 
-class BackgroundPressureAcceleration(Equation):
-    """(du/dt)_c = -p_b sum_b m_b (1/rho_a^2 + 1/rho_b^2) grad W_ab: the TVF homogenisation
-    of Adepu & Ramachandran (2024), eq. 20, in the symmetric form of Adami et al. 2013 (eq. 13)."""
+class TransportContinuity(Equation):
+    """d~rho_a/dt = rho_a sum_b V_b (u~_a - u~_b) . grad W_ab: the density follows the
+    particles, which move with u~ (Zhang, Hu & Adams 2017, eq. 12; the first part of
+    Adepu & Ramachandran 2021, eq. 25).  Initialises ``arho``, so it comes first."""
 
-    positive = ("pb",)
+    def initialize(self, d_idx, d_arho):
+        d_arho[d_idx] = 0.0
 
-    def initialize(self, d_idx, d_auhat, d_avhat, d_awhat):
-        d_auhat[d_idx] = 0.0
-        d_avhat[d_idx] = 0.0
-        d_awhat[d_idx] = 0.0
-
-    def loop(self, d_idx, d_auhat, d_avhat, d_awhat, d_rho, s_idx, s_m, s_rho, DWIJ):
-        ra = 1.0 / d_rho[d_idx]
-        rb = 1.0 / s_rho[s_idx]
-        f = -self.pb * s_m[s_idx] * (ra * ra + rb * rb)
-        d_auhat[d_idx] += f * DWIJ[0]
-        d_avhat[d_idx] += f * DWIJ[1]
-        d_awhat[d_idx] += f * DWIJ[2]
+    def loop(self, d_idx, d_arho, d_rho, d_uhat, d_vhat, d_what, s_idx, s_m, s_rho,
+             s_uhat, s_vhat, s_what, DWIJ):
+        du = d_uhat[d_idx] - s_uhat[s_idx]
+        dv = d_vhat[d_idx] - s_vhat[s_idx]
+        dw = d_what[d_idx] - s_what[s_idx]
+        vb = s_m[s_idx] / s_rho[s_idx]
+        d_arho[d_idx] += d_rho[d_idx] * vb * (du * DWIJ[0] + dv * DWIJ[1] + dw * DWIJ[2])

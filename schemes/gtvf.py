@@ -1,0 +1,87 @@
+"""Generalised transport-velocity formulation (GTVF) of Zhang, Hu & Adams (2017), for fluids:
+the baseline the CTVF of Adepu & Ramachandran (2021) improves on.
+
+* density: continuity with the transport velocity, d~rho/dt = rho sum_b V_b u~_ab . grad W
+  (Zhang et al. eq. 12), re-initialised every step by the Shepard-corrected summation
+  (eq. 13); or plain summation density (``density='summation'``);
+* pressure: the linear equation of state p = c0^2 (rho - rho0) (the Tait form with
+  gamma = 1, as PySPH's GTVF runs it);
+* momentum: symmetric pressure gradient, the transport stress div(u (x) (u~ - u))
+  (eq. 17), Morris viscosity (which equals Zhang et al.'s inter-particle-averaged form
+  for kinematic viscosity), optional artificial viscosity;
+* homogenisation: their (du/dt)_c = -p0_a sum_b m_b/rho_a^2 grad W(r_ab, h/2),
+  p0_a = min(10|p_a|, p_ref) by default, or any other technique of
+  :mod:`sphgen.equations.shifting` (the paper's section 4.4 runs GTVF with SPST);
+* kick-drift-kick as in the CTVF scheme, and its time step (Adepu & Ramachandran eq. 61)
+  so that the two schemes differ only in their equations.
+
+No CTVF corrections: no -u div(u~ - u) term, and the pressure follows the density.
+"""
+from sphgen.equation import Group
+
+from ..equations.basic import SummationDensity, Vorticity2D
+from ..equations.density import CorrectedSummationDensity, SaveDensity
+from ..equations.momentum import ArtificialViscosity, LaminarViscosity, PressureGradient
+from ..equations.transport import TransportContinuity, TransportStress
+from ..equations.wcsph import TaitEOS
+from .ctvf import TransportVelocityScheme
+
+
+class GTVFScheme(TransportVelocityScheme):
+    """GTVF for fluids (Zhang, Hu & Adams 2017).
+
+    ``shifting`` defaults to 'gtvf' (their homogenisation, ``p_ref`` = rho0 c0^2 by
+    default, kernel gradient at h/2); ``density`` 'continuity' (their eqs. 12-13,
+    default) or 'summation'.  Other keywords, the time step, the stability and density
+    bounds are those of :class:`~sphgen.schemes.ctvf.TransportVelocityScheme`.
+    """
+
+    evolve_pressure = False
+
+    def __init__(self, fluids, dim, rho0, c0, nu, h, dx, umax=1.0, shifting="gtvf",
+                 density="continuity", **kw):
+        super().__init__(fluids, dim, rho0, c0, nu, h, dx, umax=umax, shifting=shifting,
+                         density=density, **kw)
+
+    def setup_properties(self, arrays):
+        super().setup_properties(arrays)
+        for pa in arrays:
+            for p in ("rhostar", "shepard"):
+                if not pa.has(p):
+                    pa.add_property(p)
+
+    def _rate_groups(self):
+        """Evaluation 0: drho/dt with u~ (Zhang et al. eq. 12), or nothing to do."""
+        if self.density != "continuity":
+            return []
+        return [Group([TransportContinuity(d, self._sources(d)) for d in self.fluids])]
+
+    def _density_groups(self):
+        """Density (eq. 13, or summation), then p = c0^2 (rho - rho0)."""
+        groups = []
+        if self.density == "continuity":
+            groups += [Group([SaveDensity(d) for d in self.fluids]),
+                       Group([CorrectedSummationDensity(d, self._sources(d)) for d in self.fluids])]
+        else:
+            groups.append(Group([SummationDensity(d, self._sources(d)) for d in self.fluids]))
+        groups.append(Group([TaitEOS(d, rho0=self.rho0, c0=self.c0, gamma=1.0) for d in self.fluids]))
+        return groups
+
+    def _momentum_group(self):
+        """Zhang et al. eq. 17: pressure gradient, transport stress, viscosity, (du/dt)_c."""
+        eqs = []
+        for d in self.fluids:
+            src = self._sources(d)
+            eqs += [PressureGradient(d, src, bql=False),
+                    LaminarViscosity(d, src, nu=self.nu),
+                    ArtificialViscosity(d, src, alpha=self.alpha, c0=self.c0),
+                    TransportStress(d, src, enabled=self.shift.active)]
+            eqs += self._body_force(d) + self.shift.momentum_equations(d, src)
+            if self.dim == 2:
+                eqs.append(Vorticity2D(d, src))
+        return Group(eqs)
+
+    def get_equations(self):
+        src = self._sources(self.fluids[0])
+        second = self._density_groups() + [self._momentum_group()] + self.shift.groups(self.fluids, src)
+        return [self._rate_groups(), second]

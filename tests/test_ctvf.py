@@ -1,0 +1,334 @@
+"""CTVF (Adepu & Ramachandran 2021): correction terms, shifting pieces and the scheme."""
+import json
+
+import numpy as np
+import pytest
+
+from sphgen.app import load_application
+from sphgen.equation import Equation, Group
+from sphgen.equations import shifting, transport
+from sphgen.equations.ctvf import (ContinuityTransportCorrection, EDACTransportCorrection,
+                                   MomentumTransportDivergence)
+from sphgen.equations.shifting import IPSTAcceleration, IPSTShift, IPSTStart, lattice_chi
+from sphgen.equations.transport import TransportStress
+from sphgen.kernels import QuinticSpline
+from sphgen.scene import Scene
+from sphgen.schemes.ctvf import CTVFScheme
+from sphgen.solver import Solver
+
+from conftest import assert_close, lattice_cloud, periodic_box
+
+TWO_PI = 2.0 * np.pi
+
+
+def build(scheme, pa, backend="cython", periodic=True):
+    scheme.setup_properties([pa])
+    integ = scheme.get_integrator()
+    sc = Scene([pa], scheme.get_equations(), steppers=integ.steppers, kernel=scheme.kernel,
+               dim=scheme.dim, domain=periodic_box(scheme.dim) if periodic else None,
+               outputs={"fluid": list(scheme.output_props)}, backend=backend)
+    integ.attach(sc)
+    return sc, integ
+
+
+def cloud(nx=10, seed=3):
+    pa = lattice_cloud(nx=nx, jitter=0.25, seed=seed)
+    rng = np.random.default_rng(seed + 1)
+    pa.add_property("p", data=rng.uniform(-0.5, 0.5, pa.n))
+    return pa
+
+
+def steps(sc, integ, scheme, n):
+    dt = scheme.get_timestep()
+    integ.initial_accelerations(0.0, dt)
+    for k in range(n):
+        integ.one_timestep(k * dt, dt)
+
+
+# ------------------------------------------------------------------ compiled == Python
+@pytest.mark.parametrize("kw", [
+    dict(shifting="spst", alpha=0.2, bql=True),
+    dict(shifting="spst", density="continuity"),
+    dict(shifting="ipst", ipst_max_iterations=3),
+    dict(shifting="gtvf", corrections=("edac",)),
+], ids=["spst-bql-alpha", "spst-continuity", "ipst", "gtvf-shift"])
+def test_ctvf_compiled_matches_python(kw):
+    out = {}
+    for backend in ("cython", "python"):
+        pa = cloud()
+        s = CTVFScheme(["fluid"], dim=2, rho0=1.0, c0=10.0, nu=0.01, h=0.1, dx=0.1, **kw)
+        sc, integ = build(s, pa, backend)
+        steps(sc, integ, s, 2)
+        out[backend] = (pa, sc)
+    a, sca = out["cython"]
+    b, _ = out["python"]
+    kept = {type(ep.eq).__name__ for ep in sca.plan.eqplans if ep.kept}
+    assert "EDACTransportCorrection" in kept
+    assert ("TransportStress" in kept) == ("stress" in kw.get("corrections", ("stress",)))
+    if kw.get("density") == "continuity":
+        assert {"TransportContinuity", "ContinuityTransportCorrection"} <= kept
+    if kw["shifting"] == "ipst":
+        assert {"IPSTStart", "IPSTShift", "IPSTAcceleration"} <= kept
+    assert sorted(a.data) == sorted(b.data)
+    for name in a.data:
+        assert_close(a.data[name], b.data[name], 1e-11, what=f"{kw}: {name}")
+    assert np.abs(a.ap).max() > 0 and np.abs(a.auhat).max() > 0
+
+
+# -------------------------------------------------- correction terms vs analytic values
+class ZeroRates(Equation):
+    def initialize(self, d_idx, d_ap, d_au, d_av, d_aw, d_arho):
+        d_ap[d_idx] = 0.0
+        d_au[d_idx] = 0.0
+        d_av[d_idx] = 0.0
+        d_aw[d_idx] = 0.0
+        d_arho[d_idx] = 0.0
+
+
+# smooth periodic fields: velocity u, shift delta = u~ - u, pressure p, density rho
+def f_u(x, y):
+    return np.sin(TWO_PI * x) * np.cos(TWO_PI * y)
+
+
+def f_v(x, y):
+    return -np.cos(TWO_PI * x) * np.sin(TWO_PI * y)
+
+
+def f_dx(x, y):
+    return 0.3 * np.sin(TWO_PI * x + 1.0) + 0.1 * np.cos(TWO_PI * y)
+
+
+def f_dy(x, y):
+    return 0.2 * np.cos(TWO_PI * y + 0.5) - 0.1 * np.sin(TWO_PI * x)
+
+
+def f_p(x, y):
+    return np.cos(TWO_PI * x) * np.sin(TWO_PI * y) + 0.4 * np.sin(TWO_PI * (x + y))
+
+
+def f_rho(x, y):
+    return 1.0 + 0.1 * np.sin(TWO_PI * x) * np.sin(TWO_PI * y)
+
+
+def d(f, x, y, axis, eps=1e-6):
+    """Central difference of an analytic field (error ~1e-11 of the derivative)."""
+    if axis == 0:
+        return (f(x + eps, y) - f(x - eps, y)) / (2 * eps)
+    return (f(x, y + eps) - f(x, y - eps)) / (2 * eps)
+
+
+def manufactured(nx, term):
+    """(discrete, exact) of one correction term on a periodic lattice, h = dx."""
+    dx = 1.0 / nx
+    g = np.arange(nx) * dx + dx / 2
+    x, y = (a.ravel() for a in np.meshgrid(g, g, indexing="ij"))
+    rho = f_rho(x, y) if term == "continuity" else np.ones_like(x)
+    from sphgen.particles import ParticleArray
+    pa = ParticleArray("fluid", x=x, y=y, u=f_u(x, y), v=f_v(x, y), rho=rho, m=rho * dx * dx,
+                       h=np.full(x.size, dx))
+    pa.add_property("uhat", data=f_u(x, y) + f_dx(x, y))
+    pa.add_property("vhat", data=f_v(x, y) + f_dy(x, y))
+    pa.add_property("what", default=0.0)
+    pa.add_property("p", data=f_p(x, y))
+    for p in ("ap", "au", "av", "aw", "arho"):
+        pa.add_property(p)
+    eqs = {"edac": [EDACTransportCorrection], "stress": [TransportStress],
+           "divergence": [MomentumTransportDivergence], "continuity": [ContinuityTransportCorrection],
+           "both": [TransportStress, MomentumTransportDivergence]}[term]
+    eqs = [ZeroRates("fluid")] + [eq("fluid", ["fluid"]) for eq in eqs]
+    out = {"edac": ["ap"], "continuity": ["arho"]}.get(term, ["au", "av"])
+    sc = Scene([pa], [Group(eqs)], dim=2, domain=periodic_box(2), outputs={"fluid": out})
+    sc.compute(0, 0.0, 1e-3)
+    x, y = pa.x, pa.y   # the scene sorted the particles spatially
+    divd = d(f_dx, x, y, 0) + d(f_dy, x, y, 1)
+    if term == "edac":      # delta . grad p
+        return [pa.ap], [f_dx(x, y) * d(f_p, x, y, 0) + f_dy(x, y) * d(f_p, x, y, 1)]
+    if term == "continuity":  # div(rho delta)
+        return [pa.arho], [d(lambda a, b: f_rho(a, b) * f_dx(a, b), x, y, 0)
+                           + d(lambda a, b: f_rho(a, b) * f_dy(a, b), x, y, 1)]
+    exact = []
+    for f in (f_u, f_v):
+        stress = d(lambda a, b: f(a, b) * f_dx(a, b), x, y, 0) + d(lambda a, b: f(a, b) * f_dy(a, b), x, y, 1)
+        exact.append({"stress": stress, "divergence": -f(x, y) * divd, "both": stress - f(x, y) * divd}[term])
+    return [pa.au, pa.av], exact
+
+
+def rel_error(nx, term):
+    got, exact = manufactured(nx, term)
+    scale = max(np.abs(e).max() for e in exact)
+    return max(np.abs(g - e).max() for g, e in zip(got, exact)) / scale
+
+
+@pytest.mark.parametrize("term", ["edac", "stress", "divergence", "both", "continuity"])
+def test_correction_terms_converge_to_their_analytic_values(term):
+    """delta.grad p (C2), div(u (x) delta), -u div delta (C3), (delta.grad) u, div(rho delta)
+    (C1): the discrete term approaches the analytic one, about second order on a lattice."""
+    e20, e40 = rel_error(20, term), rel_error(40, term)
+    assert e40 < 0.35 * e20, (term, e20, e40)
+    assert e40 < 0.05, (term, e40)
+
+
+# ------------------------------------------------------------- switched off == absent
+def test_switched_off_corrections_are_absent_from_plan_and_source():
+    names = ("EDACTransportCorrection_", "TransportStress_", "MomentumTransportDivergence_")
+    pa = cloud(8)
+    on, _ = build(CTVFScheme(["fluid"], dim=2, rho0=1.0, c0=10.0, nu=0.01, h=0.125, dx=0.125), pa)
+    assert all(n in on.source for n in names)
+    pa = cloud(8)
+    off, _ = build(CTVFScheme(["fluid"], dim=2, rho0=1.0, c0=10.0, nu=0.01, h=0.125, dx=0.125,
+                              corrections=()), pa)
+    assert not any(n in off.source for n in names)
+    plan = off.describe()
+    for n in names:
+        assert f"prune {n[:-1]}[fluid<-fluid]: switched off (enabled=False)" in plan
+    pa = cloud(8)
+    one, _ = build(CTVFScheme(["fluid"], dim=2, rho0=1.0, c0=10.0, nu=0.01, h=0.125, dx=0.125,
+                              corrections=("divergence",)), pa)
+    assert "MomentumTransportDivergence_" in one.source and "EDACTransportCorrection_" not in one.source
+
+
+# ------------------------------------------------------------------ linear momentum
+def momentum_drift(corrections, shift="spst", nsteps=40):
+    pa = lattice_cloud(nx=16, jitter=0.3, seed=7)
+    rng = np.random.default_rng(1)
+    pa.add_property("p", data=rng.uniform(-1, 1, pa.n))
+    s = CTVFScheme(["fluid"], dim=2, rho0=1.0, c0=10.0, nu=0.02, h=1 / 16, dx=1 / 16,
+                   shifting=shift, corrections=corrections, bql=False, ipst_max_iterations=3)
+    sc, integ = build(s, pa)
+    p0 = np.array([np.sum(pa.m * pa.u), np.sum(pa.m * pa.v)])
+    scale = np.sum(pa.m * np.hypot(pa.u, pa.v))
+    solver = Solver(sc, integ, dt=s.get_timestep(), tf=1.0, max_steps=nsteps, progress=False)
+    solver.run()
+    assert solver.step == nsteps and np.abs(pa.auhat).max() > 1.0
+    return np.abs(np.array([np.sum(pa.m * pa.u), np.sum(pa.m * pa.v)]) - p0).max() / scale
+
+
+@pytest.mark.parametrize("corrections,shift", [((), "spst"), (("edac", "stress"), "spst"),
+                                               (("edac", "stress"), "ipst")])
+def test_momentum_conserved_to_round_off_without_the_divergence_term(corrections, shift):
+    """Pressure gradient, viscosity and the stress term are antisymmetric pair by pair; the
+    EDAC terms change only p.  So sum m u stays put with those (bql off)."""
+    assert momentum_drift(corrections, shift) < 1e-12
+
+
+def test_momentum_drift_with_the_divergence_term(capsys):
+    """-u div(u~ - u) is not antisymmetric: report its drift (docs/validation_ctvf.md)."""
+    drift = momentum_drift(("edac", "stress", "divergence"))
+    with capsys.disabled():
+        print(f"\nCTVF (SPST, all corrections), 40 steps on a jittered cloud: "
+              f"relative linear-momentum drift {drift:.2e}")
+    assert 1e-10 < drift < 1e-2
+
+
+# ---------------------------------------------------------------------- shifting
+def test_spst_and_tvf_are_re_exported_from_transport():
+    assert transport.SunShiftingAcceleration is shifting.SunShiftingAcceleration
+    assert transport.BackgroundPressureAcceleration is shifting.BackgroundPressureAcceleration
+
+
+def test_lattice_chi_is_the_initial_value_of_a_lattice():
+    k = QuinticSpline(2)
+    assert lattice_chi(k, 0.1, 0.1, 2) == pytest.approx(1.0001, abs=2e-4)
+    pa = lattice_cloud(nx=10, jitter=0.0)
+    pa.rho[:] = 1.0
+    shifting.Shifting("ipst", 2, 0.1, 0.1, 10.0, 1.0, k).setup_properties(pa)
+    sc = Scene([pa], [Group([IPSTShift("fluid", ["fluid"], chi_ref=1.0)])], dim=2, domain=periodic_box(2),
+               outputs={"fluid": ["ipst_chi", "ipst_dx"]})
+    x0 = pa.x.copy()
+    sc.compute(0, 0.0, 1e-3)
+    np.testing.assert_allclose(pa.ipst_chi, lattice_chi(k, 0.1, 0.1, 2), rtol=1e-12)
+    assert np.abs(pa.ipst_dx).max() < 1e-15            # a lattice needs no shift
+    assert np.abs(((pa.x - x0 + 0.5) % 1.0) - 0.5).max() < 1e-15
+
+
+def ipst_scene(tol=0.02, max_it=10, nx=12, jitter=0.2):
+    pa = lattice_cloud(nx=nx, jitter=jitter, seed=5)
+    sh = shifting.Shifting("ipst", 2, 1 / nx, 1 / nx, 10.0, 1.0, QuinticSpline(2),
+                           ipst_tolerance=tol, ipst_max_iterations=max_it)
+    sh.setup_properties(pa)
+    groups = sh.groups(["fluid"], ["fluid"])
+    sc = Scene([pa], groups, dim=2, domain=periodic_box(2), outputs={"fluid": ["auhat", "avhat"]})
+    return pa, sc, groups
+
+
+def test_ipst_iterates_shifts_and_returns_the_displacement_as_an_acceleration():
+    """Eqs. 37-41: positions are restored; (du/dt)_c dt^2/2 is the iterated displacement,
+    which makes the distribution more uniform (max chi closer to the lattice value)."""
+    pa, sc, groups = ipst_scene(max_it=6)
+    x0, y0 = pa.x.copy(), pa.y.copy()
+    dt = 0.01
+    chi_ref = groups[1].equations[0].chi_ref
+    sc.compute(0, 0.0, dt)
+    first = groups[1].equations[0]
+    assert groups[1].iterations == 6 and first.shifted        # 0.2 dx jitter: not converged
+    assert np.array_equal(pa.x, x0) and np.array_equal(pa.y, y0)   # positions restored
+    disp = 0.5 * dt * dt * np.array([pa.auhat, pa.avhat])
+    assert np.abs(disp).max() > 1e-4 / 12
+    # apply the displacement: the particles are more uniform than before
+    chi = []
+    for shift in (0.0, 1.0):
+        q = lattice_cloud(nx=12, jitter=0.0)
+        q.x[:] = pa.x + shift * disp[0]    # pa's order: the scene sorted its particles
+        q.y[:] = pa.y + shift * disp[1]
+        q.rho[:] = pa.rho
+        shifting.Shifting("ipst", 2, 1 / 12, 1 / 12, 10.0, 1.0, QuinticSpline(2)).setup_properties(q)
+        s2 = Scene([q], [Group([IPSTShift("fluid", ["fluid"], chi_ref=chi_ref)])], dim=2,
+                   domain=periodic_box(2), outputs={"fluid": ["ipst_chi", "ipst_dx"]})
+        s2.compute(0, 0.0, dt)
+        chi.append(abs(q.ipst_chi.max() - chi_ref))
+    assert chi[1] < 0.8 * chi[0], chi
+
+
+def test_ipst_stops_when_converged():
+    pa, sc, groups = ipst_scene(tol=0.5, max_it=10)
+    sc.compute(0, 0.0, 0.01)
+    # the first sweep always shifts; the second sees a converged configuration and stops
+    assert groups[1].iterations == 2 and not groups[1].equations[0].shifted
+    assert np.abs(pa.auhat).max() > 0
+
+
+def test_ipst_every_k_steps_zeroes_the_acceleration_in_between():
+    sh = shifting.Shifting("ipst", 2, 0.1, 0.1, 10.0, 1.0, QuinticSpline(2), ipst_interval=3)
+    cond = sh.groups(["fluid"], ["fluid"])[0].condition
+    dt = 1e-3
+    assert [cond(k * dt, dt) for k in range(7)] == [True, False, False, True, False, False, True]
+    assert [type(e).__name__ for e in sh.momentum_equations("fluid", ["fluid"])] == ["ZeroHomogenisation"]
+
+
+# ------------------------------------------------------------------------ scheme
+def test_time_step_and_stability_bounds():
+    s = CTVFScheme(["fluid"], dim=2, rho0=1.0, c0=10.0, nu=0.01, h=0.02, dx=0.02)
+    assert s.get_timestep() == pytest.approx(min(0.25 * 0.02 / 11.0, 0.25 * 0.02 ** 2 / 0.01))
+    assert not s.check_stability(s.get_timestep())
+    from sphgen.errors import StabilityError
+    with pytest.raises(StabilityError, match="eq. 61"):
+        s.check_stability(1.5 * s.get_timestep())
+    g = CTVFScheme(["fluid"], dim=2, rho0=1.0, c0=10.0, nu=0.0, h=0.02, dx=0.02, gy=-9.81)
+    assert g.get_timestep() == pytest.approx(0.25 * 0.02 / 11.0)
+    with pytest.raises(ValueError, match="unknown correction"):
+        CTVFScheme(["fluid"], dim=2, rho0=1.0, c0=10.0, nu=0.0, h=0.02, dx=0.02, corrections=("A",))
+    with pytest.raises(ValueError, match="shifting must be one of"):
+        CTVFScheme(["fluid"], dim=2, rho0=1.0, c0=10.0, nu=0.0, h=0.02, dx=0.02, shifting="sun")
+
+
+def run_tg(tmp_path, *extra, nx=30, tf=0.3):
+    out = tmp_path / "tg"
+    app = load_application("taylor_green")()
+    app.run(["--nx", str(nx), "--re", "100", "--tf", str(tf), "-d", str(out), "--disable-output",
+             "--no-progress", *extra])
+    with open(out / "results.json") as f:
+        return json.load(f), app
+
+
+@pytest.mark.parametrize("nx,extra,l1max,umax", [
+    (40, ("--scheme", "ctvf"), 0.13, 0.10),
+    (30, ("--scheme", "ctvf", "--shifting", "ipst"), 0.09, 0.07),
+], ids=["spst", "ipst"])
+def test_short_taylor_green_run(tmp_path, nx, extra, l1max, umax):
+    """Measured (Re 100, t = 0.3): SPST nx 40 L1 max 0.108, max|u| -7.4 %; IPST nx 30
+    L1 max 0.074, max|u| -4.9 %."""
+    res, app = run_tg(tmp_path, *extra, nx=nx)
+    assert type(app.scheme).__name__ == "CTVFScheme" and app.scheme.bql
+    assert res["t"] == pytest.approx(0.3)
+    assert res["l1_error_max"] <= l1max, res
+    assert abs(res["max_u_rel_error"]) <= umax, res
