@@ -9,8 +9,18 @@ compiled like equations::
 
 An integrator sequences stages, equation evaluations and neighbour updates in plain
 Python (``one_timestep``); the per-particle work is compiled.
+
+Prescribed values are re-imposed after every stage: ``add_motion(array, f)`` sets what
+``f(t, pa)`` returns ({property: values}) at the time the stage's positions stand for
+(``position_time``: the fraction of dt each stage reaches), e.g. a moving piston or a
+rotating wall; ``clamp(array, gids, u=0.0, ...)`` holds values of the particles with those
+persistent ids fixed, e.g. a clamped base.  Particles are re-sorted in memory during a
+run, so per-particle reference data a motion needs must be a property of the array
+(it moves with its particle), and clamps name particles by ``gid``, not by index.
 """
 import re
+
+import numpy as np
 
 
 class IntegratorStep:
@@ -31,6 +41,7 @@ class Integrator:
     """
 
     n_evaluations = 1
+    position_time = {}     # stage -> fraction of dt its positions stand for (default 1)
 
     def __init__(self, **steppers):
         for name, st in steppers.items():
@@ -39,6 +50,35 @@ class Integrator:
         self.steppers = steppers
         self.scene = None
         self.nnps_updates = 0
+        self.motions = []      # (array, f(t, pa) -> {prop: values})
+        self.clamps = []       # (array, gids, {prop: value})
+        self.t_step, self.dt_step = 0.0, 0.0
+
+    def add_motion(self, array, motion):
+        """Prescribe properties of ``array`` in time: ``motion(t, pa) -> {prop: values}``."""
+        self.motions.append((array, motion))
+
+    def clamp(self, array, gids, **values):
+        """Hold properties of the particles ``gids`` of ``array`` at fixed values (scalars,
+        or arrays ordered like ``gids``) after every stage."""
+        self.clamps.append((array, np.asarray(gids, dtype=np.int64), values))
+
+    def impose(self, t):
+        """Set the prescribed motions at time ``t`` and re-impose the clamps."""
+        for array, motion in self.motions:
+            pa = self.scene.by_name[array]
+            for prop, value in motion(t, pa).items():
+                pa.get(prop)[:] = value
+        for array, gids, values in self.clamps:
+            pa = self.scene.by_name[array]
+            where = np.argsort(pa.gid)[np.searchsorted(pa.gid, gids, sorter=np.argsort(pa.gid))]
+            for prop, value in values.items():
+                pa.get(prop)[where] = value
+
+    def advance(self, t, dt):
+        """One step from t (what the solver calls): ``one_timestep`` with the step's times known."""
+        self.t_step, self.dt_step = t, dt
+        self.one_timestep(t, dt)
 
     def attach(self, scene):
         self.scene = scene
@@ -50,6 +90,8 @@ class Integrator:
     # what one_timestep may call
     def stage(self, name, t, dt):
         self.scene.stage(name, t, dt)
+        if self.motions or self.clamps:
+            self.impose(self.t_step + self.position_time.get(name, 1.0) * self.dt_step)
 
     def compute_accelerations(self, index, t, dt):
         self.scene.compute(index, t, dt)
@@ -74,6 +116,7 @@ class KickDriftKick(Integrator):
     """
 
     n_evaluations = 2
+    position_time = {"stage1": 0.0, "stage2": 1.0, "stage3": 1.0}
 
     def initial_accelerations(self, t, dt):
         self.compute_accelerations(1, t, dt)
@@ -91,6 +134,7 @@ class PEC(Integrator):
     """Predict (half step), evaluate, correct (full step with midpoint rates)."""
 
     n_evaluations = 1
+    position_time = {"stage1": 0.5, "stage2": 1.0}
 
     def one_timestep(self, t, dt):
         self.stage("stage1", t, dt)
@@ -103,6 +147,7 @@ class EPEC(Integrator):
     """Evaluate, predict, evaluate, correct: two evaluations and two neighbour updates."""
 
     n_evaluations = 2
+    position_time = {"stage1": 0.5, "stage2": 1.0}
 
     def one_timestep(self, t, dt):
         self.compute_accelerations(0, t, dt)

@@ -207,6 +207,8 @@ class Solver:
                 elif self.restarted:
                     self.index.add(path)
         if not self.restarted:
+            if self.integrator.motions or self.integrator.clamps:
+                self.integrator.impose(self.t)
             # a restart file carries the accelerations of its step: recomputing them from
             # the end-of-step velocities would not reproduce the uninterrupted run
             self.integrator.initial_accelerations(self.t, self.dt)
@@ -233,7 +235,7 @@ class Solver:
         dt = self.next_dt()
         start = time.perf_counter()
         try:
-            self.integrator.one_timestep(self.t, dt)
+            self.integrator.advance(self.t, dt)
         except ValueError:
             bad = self.scene.check_finite() if self.guard else None
             if bad is None:
