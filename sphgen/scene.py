@@ -44,7 +44,7 @@ class Scene:
         for pa in self.arrays:
             for p in self.plan.allocation[pa.name]:
                 pa.allocate(p)
-        self.nnps = NeighbourSearch(self.arrays, dim, self.kernel.radius_scale, domain)
+        self.nnps = NeighbourSearch(self.searched_arrays(), dim, self.kernel.radius_scale, domain)
         self.backend = backend
         self.engine = BACKENDS[backend](self.plan, self.nnps)
         self.setup_time = time.perf_counter() - t0
@@ -52,6 +52,12 @@ class Scene:
         self.nnps.update()
         self._freeze_reference_lists()
         self.bind()
+
+    def searched_arrays(self):
+        """The arrays some neighbour loop visits; an array that interacts with nothing gets
+        no neighbour search (nor periodic wrapping or sorting).  All, if none interacts."""
+        used = {a for d, s, _ in self.plan.neighbour_lists() for a in (d, s)}
+        return [pa for pa in self.arrays if pa.name in used] or self.arrays
 
     # the generated module, if the backend has one
     compile_time = property(lambda self: self.engine.compile_time)

@@ -74,3 +74,13 @@ def test_clamped_particles_do_not_move_under_a_force():
 
 def test_kick_drift_kick_stage_times():
     assert KickDriftKick.position_time == {"stage1": 0.0, "stage2": 1.0, "stage3": 1.0}
+
+
+def test_an_array_that_interacts_with_nothing_gets_no_neighbour_search():
+    from sphgen.equations.basic import SummationDensity
+    fluid = lattice_cloud("fluid", nx=4)
+    probe = lattice_cloud("probe", nx=2)
+    sc = Scene([fluid, probe], [SummationDensity("fluid", ["fluid"])], dim=2, outputs={"fluid": ["rho"]})
+    assert [pa.name for pa in sc.nnps.arrays] == ["fluid"]
+    sc.update_nnps()
+    sc.sort()
