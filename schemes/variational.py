@@ -42,6 +42,10 @@ from ..equations.variational import (GaussianContinuityDensity, GaussianPressure
 from ..equations.walls import LennardJonesWallForce
 from ..equations.wcsph import TaitEOS
 
+PREDICTORS = {"verlet": 0, "linear": 1, "previous": 2}
+"""Initial guess q^(0) of the iteration (digest A15): verlet q_k + dt (v_{k-1,k} + dt (a_2 +
+Gamma_k + g)) (default), linear 2 q_k - q_{k-1}, previous q_k."""
+
 FLUID_PROPS = ("xk", "yk", "uh", "vh", "ui", "vi", "xi", "yi", "a2x", "a2y", "gwx", "gwy",
                "rhok", "res", "p", "arho", "au", "av", "aw")
 
@@ -53,9 +57,12 @@ class VariationalStep(IntegratorStep):
     startup finalisation; stage6-9 the fixed-point iteration (eqs. 40, 63); stage10 accept.
     """
 
-    def __init__(self, alpha=0.5, gx=0.0, gy=0.0):
+    switches = ("predictor",)
+
+    def __init__(self, alpha=0.5, gx=0.0, gy=0.0, predictor=0):
         self.alpha = float(alpha)
         self.gx, self.gy = float(gx), float(gy)
+        self.predictor = int(predictor)   # PREDICTORS: 0 verlet, 1 linear, 2 previous
 
     def stage1(self, d_idx, d_u, d_v, d_uh, d_vh, d_rho, d_rhok, dt):
         d_uh[d_idx] = d_u[d_idx] - 0.5 * dt * self.gx
@@ -111,8 +118,15 @@ class VariationalStep(IntegratorStep):
                d_au, d_av, d_a2x, d_a2y, d_gwx, d_gwy, dt):
         d_gwx[d_idx] = d_au[d_idx]
         d_gwy[d_idx] = d_av[d_idx]
-        d_ui[d_idx] = d_uh[d_idx] + dt * ((d_a2x[d_idx] + d_gwx[d_idx]) + self.gx)
-        d_vi[d_idx] = d_vh[d_idx] + dt * ((d_a2y[d_idx] + d_gwy[d_idx]) + self.gy)
+        if self.predictor == 0:
+            d_ui[d_idx] = d_uh[d_idx] + dt * ((d_a2x[d_idx] + d_gwx[d_idx]) + self.gx)
+            d_vi[d_idx] = d_vh[d_idx] + dt * ((d_a2y[d_idx] + d_gwy[d_idx]) + self.gy)
+        elif self.predictor == 1:
+            d_ui[d_idx] = d_uh[d_idx]
+            d_vi[d_idx] = d_vh[d_idx]
+        else:
+            d_ui[d_idx] = 0.0
+            d_vi[d_idx] = 0.0
         d_xi[d_idx] = d_xk[d_idx] + dt * d_ui[d_idx]
         d_yi[d_idx] = d_yk[d_idx] + dt * d_vi[d_idx]
         d_x[d_idx] = (1.0 - self.alpha) * d_xk[d_idx] + self.alpha * d_xi[d_idx]
@@ -262,7 +276,7 @@ class VariationalScheme(Scheme):
     def __init__(self, fluids, walls, dim=2, rho0=1000.0, c0=23.841, gx=0.0, gy=0.0,
                  kernel="K3", dx=0.005, h_cut=0.072, av_a=1.0, av_b=1.0, D=5.684, r0=0.005,
                  wall_power=1, integrator="variational", alpha=0.5, tol=1e-3, max_iter=50,
-                 gamma=7.0):
+                 gamma=7.0, predictor="verlet", dt=None):
         if dim != 2:
             raise ValueError("VariationalScheme: only dim = 2 is implemented")
         if integrator not in ("variational", "explicit"):
@@ -278,6 +292,9 @@ class VariationalScheme(Scheme):
         self.hphi = h_cut if kernel in ("K1", "K2") else self.lam   # digest A34
         self.av_a, self.av_b, self.D, self.r0, self.wall_power = av_a, av_b, D, r0, wall_power
         self.integrator, self.alpha, self.tol, self.max_iter = integrator, alpha, tol, max_iter
+        if predictor not in PREDICTORS:
+            raise ValueError(f"VariationalScheme: predictor {predictor!r}: {', '.join(PREDICTORS)}")
+        self.predictor, self.dt = predictor, dt
         self.B = rho0 * c0 * c0 / gamma
         self.kernel = get_kernel("quintic", dim)
         self.speed_limit = c0
@@ -312,14 +329,16 @@ class VariationalScheme(Scheme):
 
     def get_integrator(self):
         step = VariationalStep(alpha=self.alpha if self.integrator == "variational" else 1.0,
-                               gx=self.gx, gy=self.gy)
+                               gx=self.gx, gy=self.gy, predictor=PREDICTORS[self.predictor])
         steppers = {name: step for name in self.fluids}
         if self.integrator == "explicit":
             return ExplicitLeapfrog(**steppers)
         return VariationalMidpoint(alpha=self.alpha, tol=self.tol, max_iter=self.max_iter, **steppers)
 
     def get_timestep(self):
-        """dt = 0.25 lam / c0 (acoustic CFL on the kernel width; the paper fixes dt = 1e-4)."""
+        """``dt`` if given (the paper's 1e-4 s), else 0.25 lam / c0 (acoustic CFL on the kernel width)."""
+        if self.dt is not None:
+            return self.dt
         return 0.25 * self.lam / self.c0 if self.kernel_name != "K1" else 0.25 * self.dx / self.c0
 
     def stability_bounds(self, dt):
@@ -327,7 +346,8 @@ class VariationalScheme(Scheme):
         monitored at run time (eq. 54 is not reliable: digest A20)."""
         if Bound is None:
             return []
-        return [Bound("--dt", dt, 2.0 * self.get_timestep(), True,
+        cfl = 0.25 * self.lam / self.c0 if self.kernel_name != "K1" else 0.25 * self.dx / self.c0
+        return [Bound("--dt", dt, 2.0 * cfl, True,
                       "dt <= 0.5 lam/c0 (acoustic CFL; da Silva & Giraldi 2024 use dt = 1e-4 s)")]
 
     def density_bounds(self):
