@@ -115,3 +115,20 @@ def test_generated_code_matches_the_python_evaluator():
     for name in ("x", "y", "uh", "vh", "rho", "p", "arho", "au", "gwx", "gwy", "a2x"):
         assert_close(a.data[name], b.data[name], 1e-11, what=name)
     assert np.abs(a.gwx).max() > 0 or np.abs(a.gwy).max() > 0
+
+
+@pytest.mark.parametrize("kernel", ["K2", "K3"])
+def test_normalised_gaussian_variants(kernel):
+    """K2/K3: the W whose gradient the equations use integrates to 1 in 2-D and vanishes at rc."""
+    from sphgen.equations.variational import gauss_grad_factor, kernel_parameters
+    ell, lam, rc, shift = kernel_parameters(kernel, DX, 0.072)
+    r = np.linspace(0.0, rc, 200001)
+    q2, k2 = (r / lam) ** 2, (rc / lam) ** 2
+    w = ell * (np.exp(-q2) + shift * q2 - shift * (1.0 + k2))
+    integral = np.sum(0.5 * (w[1:] * r[1:] + w[:-1] * r[:-1]) * np.diff(r)) * 2.0 * np.pi
+    assert abs(integral - 1.0) < 1e-8 and abs(w[-1]) < 1e-12 * ell
+    dwdr = np.gradient(w, r)
+    i = np.array([1000, 50000, 150000])
+    f = np.array([gauss_grad_factor(ri, ell, lam, rc, shift) * ri for ri in r[i]])
+    np.testing.assert_allclose(f, dwdr[i], rtol=1e-6)
+    assert gauss_grad_factor(rc * 1.0001, ell, lam, rc, shift) == 0.0
