@@ -162,6 +162,13 @@ class TaylorGreen(Application):
         return s
 
     def post_step(self, solver):
+        if getattr(self, "_ipst_groups", None) is None:
+            self._ipst_groups = [gp.group for row in self.scene.plan.group_plans for gp in row
+                                 if gp.group.iterate]
+            self.ipst_sweeps = [0, 0]
+        for g in self._ipst_groups:   # IPST: sweeps of its iterated group this step
+            self.ipst_sweeps[0] += g.iterations
+            self.ipst_sweeps[1] += 1
         every = max(1, int(round(0.005 / solver.dt)))
         if solver.step % every == 0 or solver.t >= solver.tf - 1e-12 or len(self.history) == 0:
             self.record(solver.t)
@@ -204,6 +211,9 @@ class TaylorGreen(Application):
                    # for `sphgen stress`: kinetic energy against the exact decay, density
                    "energy_error": float(np.abs(ke / ke_exact - 1.0).max()),
                    "max_density_error": float(drho.max())}
+        sweeps = getattr(self, "ipst_sweeps", [0, 0])
+        if sweeps[1]:   # IPST runs: mean sweeps of the iterated group per step (this session)
+            results["ipst_sweeps_mean"] = sweeps[0] / sweeps[1]
         io.write_json(os.path.join(outdir, "results.json"), results)
         self.plot(outdir, t, umax, uex, l1, label=f"sphgen {getattr(getattr(self, 'options', None), 'scheme', 'edac').upper()}")
         print(f"taylor_green: t={results['t']:.4g}  L1(|u|)={results['l1_error']:.4f} "
