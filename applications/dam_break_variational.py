@@ -21,6 +21,8 @@ with these defaults (digest seed-004 section 3.6 / 6):
 ``post_process`` writes ``results.json``: iteration statistics (mean/max iterations, largest
 residual and contraction ratio), the momentum Q(t) = |sum m v|/M (v the mean of the two
 half-step velocities around t_k, A25; Q is not conserved with gravity and walls, A24),
+the largest momentum-budget residual |sum m (v_{k+1/2} - v_{k-1/2}) - dt sum m (Gamma_k + g)|/M
+(the identity that holds to round-off with walls and gravity),
 the toe against Koshizuka & Oka (1996) and Martin & Moyce (1952), report-only, and plots
 ``toe.png``, ``momentum.png``, ``iterations.png``.
 """
@@ -59,7 +61,7 @@ class DamBreakVariational(Application):
     pfreq = 1000
     dim = 2
     history_columns = ("t", "T", "toe", "Q", "px", "py", "iterations_max", "residual_max",
-                       "contraction_max", "rho_min", "rho_max", "kinetic", "potential", "internal")
+                       "contraction_max", "budget_max", "rho_min", "rho_max", "kinetic", "potential", "internal")
 
     def add_user_options(self, group):
         group.add_argument("--integrator", choices=("variational", "explicit"), default="variational",
@@ -100,6 +102,7 @@ class DamBreakVariational(Application):
         self.history = []
         self._next_record = 0.0
         self._p_prev = None
+        self._budget = 0.0
         self._window = []
         self.all_iterations = []
 
@@ -156,6 +159,10 @@ class DamBreakVariational(Application):
             self.all_iterations.append(row)
             self._window.append(row)
         p = np.array([np.sum(f.m * f.u), np.sum(f.m * f.v)])   # sum m v_{k+1/2} after the step
+        if self._p_prev is not None:
+            # momentum budget (digest 1.10): sum m dv = dt sum m (Gamma_k + g), to round-off
+            imp = solver.last_dt * np.array([np.sum(f.m * f.gwx), np.sum(f.m * (f.gwy - G))])
+            self._budget = max(self._budget, float(np.abs(p - self._p_prev - imp).max()) / self.M)
         p_mid = p if self._p_prev is None else 0.5 * (p + self._p_prev)
         self._p_prev = p
         if solver.t + 1e-12 >= self._next_record or solver.t >= solver.tf - 1e-12:
@@ -168,8 +175,10 @@ class DamBreakVariational(Application):
                 float(p_mid[0]), float(p_mid[1]),
                 float(w[:, 0].max()) if w.size else 0.0, float(w[:, 1].max()) if w.size else 0.0,
                 float(np.nanmax(w[:, 2])) if w.size and np.isfinite(w[:, 2]).any() else float("nan"),
+                self._budget,
                 float(f.rho.min()), float(f.rho.max()), e["kinetic"], e["potential"], e["internal"]])
             self._next_record = solver.t + self.options.record_every
+            self._budget = 0.0
 
     # ------------------------------------------------------------ results
     def post_process(self, outdir):
@@ -187,6 +196,7 @@ class DamBreakVariational(Application):
         results.update({"t": float(cols["t"][-1]), "T": float(T[-1]), "n_samples": int(rows.shape[0]),
                         "Q_max": float(cols["Q"].max()), "t_Q_max": float(cols["t"][np.argmax(cols["Q"])]),
                         "Q_final": float(cols["Q"][-1]),
+                        "momentum_budget_residual_max": float(cols["budget_max"].max()),
                         "rho_min": float(cols["rho_min"].min()), "rho_max": float(cols["rho_max"].max())})
         refs = {"martin_moyce_a2.25in": reference.martin_moyce_1952(2.25),
                 "martin_moyce_a1.125in": reference.martin_moyce_1952(1.125),

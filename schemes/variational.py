@@ -80,7 +80,9 @@ class VariationalStep(IntegratorStep):
         d_a2y[d_idx] = d_av[d_idx]
 
     def stage4(self, d_idx, d_x, d_y, d_xk, d_yk, d_u, d_v, d_uh, d_vh, d_au, d_av, d_a2x, d_a2y,
-               d_rho, d_rhok, dt):
+               d_gwx, d_gwy, d_rho, d_rhok, dt):
+        d_gwx[d_idx] = d_au[d_idx]
+        d_gwy[d_idx] = d_av[d_idx]
         d_uh[d_idx] = d_uh[d_idx] + dt * ((d_a2x[d_idx] + d_au[d_idx]) + self.gx)
         d_vh[d_idx] = d_vh[d_idx] + dt * ((d_a2y[d_idx] + d_av[d_idx]) + self.gy)
         d_x[d_idx] = d_xk[d_idx] + dt * d_uh[d_idx]
