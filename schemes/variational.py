@@ -54,7 +54,8 @@ class VariationalStep(IntegratorStep):
     """Per-particle stages of both integrators (2-D; da Silva & Giraldi 2024, eqs. 60-65).
 
     stage1 start rule (eq. 60); stage2-4 explicit leapfrog (eqs. 59-62); stage5 the
-    startup finalisation; stage6-9 the fixed-point iteration (eqs. 40, 63); stage10 accept.
+    startup finalisation; stage6-9 the fixed-point iteration (eqs. 40, 63); stage10 accept;
+    stage11 back to the start of the step (after a non-converged iteration).
     """
 
     switches = ("predictor",)
@@ -165,6 +166,14 @@ class VariationalStep(IntegratorStep):
         d_v[d_idx] = d_vi[d_idx]
 
 
+    def stage11(self, d_idx, d_x, d_y, d_xk, d_yk, d_u, d_v, d_uh, d_vh, d_rho, d_rhok):
+        d_x[d_idx] = d_xk[d_idx]
+        d_y[d_idx] = d_yk[d_idx]
+        d_u[d_idx] = d_uh[d_idx]
+        d_v[d_idx] = d_vh[d_idx]
+        d_rho[d_idx] = d_rhok[d_idx]
+
+
 class ExplicitLeapfrog(Integrator):
     """Explicit leapfrog of da Silva & Giraldi (2024), eqs. 59-62 (alpha in {0, 1} of eq. 38).
 
@@ -202,7 +211,8 @@ class VariationalMidpoint(ExplicitLeapfrog):
     63-65 and Algorithm 1, as a fixed-point iteration on q_{k+1} (module docstring).
 
     ``tol`` (eps, metres, on max_i |q^(j) - q^(j-1)|), ``max_iter`` (the cap: a step not
-    converged raises BlowUpError naming the step and the residual).  Per step it records
+    converged puts the arrays back to the start of the step and raises BlowUpError naming
+    the step, 1-based as the solver counts, and the residual).  Per step it records
     ``iterations``, ``residual`` (last r_j), ``residuals`` (all r_j) and ``contraction``
     (max r_j/r_{j-1}, nan for one iteration); ``history`` keeps (step, iterations, residual,
     contraction) of every step.
@@ -249,9 +259,11 @@ class VariationalMidpoint(ExplicitLeapfrog):
                 if res[-1] <= self.tol:
                     break
                 if not np.isfinite(res[-1]) or len(res) >= self.max_iter:
+                    self.stage("stage11", t, dt)   # arrays back to the start of the step
+                    self.update_nnps()
                     raise BlowUpError(
-                        f"variational fixed-point iteration did not converge at step {self.k} "
-                        f"(t={t:.6g}): residual {res[-1]:.3e} m > tol {self.tol:.3e} m after "
+                        f"variational fixed-point iteration did not converge at step {self.k + 1} "
+                        f"(t={t:.6g} -> {t + dt:.6g}): residual {res[-1]:.3e} m > tol {self.tol:.3e} m after "
                         f"{len(res)} iteration(s) (contraction ratios "
                         f"{', '.join(f'{b / a:.3g}' for a, b in zip(res, res[1:]) if a > 0) or 'n/a'})")
             self.evaluate(1, t, dt)          # rho_{k,k+1} at the accepted q_{k+1}

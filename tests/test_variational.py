@@ -98,10 +98,12 @@ def test_iteration_statistics_and_non_convergence():
     assert 1 < integ.iterations < 50 and integ.residual <= 1e-12
     assert 0.0 < integ.contraction < 1.0
     assert [h[0] for h in integ.history] == [0, 1, 2]
-    _, integ, _ = build("variational", alpha=0.5, tol=1e-300, max_iter=1)
-    integ.one_timestep(0.0, 1e-4)  # step 0: the explicit start-up step
-    with pytest.raises(BlowUpError, match=r"at step 1 .*residual \d"):
+    pa, integ, _ = build("variational", alpha=0.5, tol=1e-300, max_iter=1)
+    integ.one_timestep(0.0, 1e-4)  # step 1: the explicit start-up step
+    x1, u1 = pa.x.copy(), pa.u.copy()
+    with pytest.raises(BlowUpError, match=r"at step 2 \(t=0.0001 -> 0.0002\): residual \d"):
         integ.one_timestep(1e-4, 1e-4)
+    assert np.array_equal(pa.x, x1) and np.array_equal(pa.u, u1)   # back to the start of the step
 
 
 def test_generated_code_matches_the_python_evaluator():
