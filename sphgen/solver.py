@@ -236,6 +236,8 @@ class Solver:
         start = time.perf_counter()
         try:
             self.integrator.advance(self.t, dt)
+        except BlowUpError as e:     # raised inside the step (e.g. an iteration that diverged)
+            raise BlowUpError(f"{e}{self._save_last_good()}") from None
         except ValueError:
             bad = self.scene.check_finite() if self.guard else None
             if bad is None:

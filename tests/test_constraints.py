@@ -84,3 +84,46 @@ def test_an_array_that_interacts_with_nothing_gets_no_neighbour_search():
     assert [pa.name for pa in sc.nnps.arrays] == ["fluid"]
     sc.update_nnps()
     sc.sort()
+
+
+def test_two_live_scenes_with_the_same_module_keep_their_own_data():
+    from sphgen.equations.basic import SummationDensity
+
+    def scene(seed):
+        pa = lattice_cloud("fluid", nx=6, seed=seed)
+        return pa, Scene([pa], [SummationDensity("fluid", ["fluid"])], dim=2, outputs={"fluid": ["rho"]})
+    a, sa = scene(1)
+    b, sb = scene(2)
+    assert sa.engine.module is sb.engine.module          # one loaded module, shared
+    sa.compute(0, 0.0, 0.1)
+    sb.compute(0, 0.0, 0.1)
+    rho_a, rho_b = a.rho.copy(), b.rho.copy()
+    a.x[:] += 0.01
+    sa.update_nnps()
+    sb.update_nnps()
+    sa.compute(0, 0.0, 0.1)                               # must use a's lists, not b's
+    fresh, sf = scene(1)
+    fresh.x[:] += 0.01
+    sf.update_nnps()
+    sf.compute(0, 0.0, 0.1)
+    assert np.array_equal(a.rho, fresh.rho) and not np.array_equal(a.rho, rho_a)
+    sb.compute(0, 0.0, 0.1)
+    assert np.array_equal(b.rho, rho_b)
+
+
+def test_a_blow_up_raised_inside_a_step_keeps_the_last_good_state(tmp_path):
+    from sphgen import io
+    from sphgen.errors import BlowUpError
+    import pytest
+
+    class Diverges(PEC):
+        def one_timestep(self, t, dt):
+            super().one_timestep(t, dt)
+            if t > 0.025:
+                raise BlowUpError("iteration did not converge")
+    sc, _ = scene_with(PEC, Drift())
+    integ = Diverges(fluid=Drift())
+    solver = Solver(sc, integ, dt=0.01, tf=1.0, progress=False, outdir=str(tmp_path), prefix="d")
+    with pytest.raises(BlowUpError, match="did not converge; last good state .step 3"):
+        solver.run()
+    assert io.load(str(tmp_path / "d_last_good.h5"))["solver_data"]["step"] == 3

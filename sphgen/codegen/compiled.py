@@ -5,7 +5,13 @@ from .render import render
 
 
 class CompiledBackend(Backend):
-    """One Cython/OpenMP module for the scene; entry points named by the renderer."""
+    """One Cython/OpenMP module for the scene; entry points named by the renderer.
+
+    Two live scenes whose generated source is the same share one loaded module (its
+    array pointers and parameters are module globals).  Each backend therefore claims
+    the module before running it: if another scene bound it last, this one binds its
+    own arrays, parameters, neighbour lists and threads again (pointer updates only).
+    """
 
     name = "cython"
 
@@ -17,16 +23,27 @@ class CompiledBackend(Backend):
         self.source_path = self.module.__sphgen_source__
         self._passes = {k: getattr(self.module, v) for k, v in self.rendered.pass_entries.items()}
         self._stages = {k: getattr(self.module, v) for k, v in self.rendered.stage_entries.items()}
+        self._arrays, self._threads = None, 1
+
+    def _claim(self):
+        if getattr(self.module, "_sphgen_owner", None) is not self and self._arrays is not None:
+            self.module.set_threads(self._threads)
+            self.bind(self._arrays)
 
     def set_threads(self, n):
+        self._threads = n
         self.module.set_threads(n)
 
     def bind(self, arrays):
+        self._arrays = arrays
+        self.module._sphgen_owner = self
         self.module.bind_arrays({pa.name: (pa.n, {**pa.data, **pa.constants}) for pa in arrays})
         self.module.set_parameters({g: float(getattr(o, a)) for g, (o, a) in self.rendered.parameters.items()})
         self.bind_neighbours()
 
     def bind_neighbours(self):
+        if getattr(self.module, "_sphgen_owner", None) is not self and self._arrays is not None:
+            return self._claim()     # binds everything, these neighbour lists included
         lists = {}
         for key, (dest, src, reference) in self.rendered.neighbour_lists.items():
             lists[key] = (self.nnps.reference_neighbours(dest, src) if reference
@@ -34,14 +51,18 @@ class CompiledBackend(Backend):
         self.module.bind_neighbours(lists)
 
     def run_pass(self, npass, t, dt):
+        self._claim()
         self._passes[npass.label](t, dt)
 
     def run_stage(self, st, name, t, dt):
+        self._claim()
         self._stages[(st.array, name)](t, dt)
 
     def max_speed2(self, arrays):
+        self._claim()
         return self.module.max_speed2()
 
     def nonfinite_suspects(self, arrays):
+        self._claim()
         by_name = {pa.name: pa for pa in arrays}
         return [(by_name[a], p) for a, p, _ in self.module.count_nonfinite()]
