@@ -31,7 +31,7 @@ def build(scheme, pa, backend="cython", periodic=True):
     return sc, integ
 
 
-def cloud(nx=10, seed=3):
+def cloud(nx=10, seed=3):  # noqa: D103
     pa = lattice_cloud(nx=nx, jitter=0.25, seed=seed)
     rng = np.random.default_rng(seed + 1)
     pa.add_property("p", data=rng.uniform(-0.5, 0.5, pa.n))
@@ -50,29 +50,40 @@ def steps(sc, integ, scheme, n):
     dict(shifting="spst", alpha=0.2, bql=True),
     dict(shifting="spst", density="continuity"),
     dict(shifting="ipst", ipst_max_iterations=3),
+    dict(shifting="ipst", ipst_max_iterations=2, ipst_interval=2, dim=3),
     dict(shifting="gtvf", corrections=("edac",)),
-], ids=["spst-bql-alpha", "spst-continuity", "ipst", "gtvf-shift"])
+    dict(shifting="tvf", corrections=("stress", "divergence"), dim=3),
+], ids=["spst-bql-alpha", "spst-continuity", "ipst", "ipst-every-2nd-3d", "gtvf-shift", "tvf-3d"])
 def test_ctvf_compiled_matches_python(kw):
+    kw = dict(kw)
+    dim = kw.pop("dim", 2)
+    nx = {2: 10, 3: 6}[dim]
     out = {}
     for backend in ("cython", "python"):
-        pa = cloud()
-        s = CTVFScheme(["fluid"], dim=2, rho0=1.0, c0=10.0, nu=0.01, h=0.1, dx=0.1, **kw)
+        pa = lattice_cloud(nx=nx, dim=dim, jitter=0.25, seed=3)
+        pa.add_property("p", data=np.random.default_rng(4).uniform(-0.5, 0.5, pa.n))
+        s = CTVFScheme(["fluid"], dim=dim, rho0=1.0, c0=10.0, nu=0.01, h=1 / nx, dx=1 / nx, **kw)
         sc, integ = build(s, pa, backend)
         steps(sc, integ, s, 2)
         out[backend] = (pa, sc)
     a, sca = out["cython"]
     b, _ = out["python"]
     kept = {type(ep.eq).__name__ for ep in sca.plan.eqplans if ep.kept}
-    assert "EDACTransportCorrection" in kept
-    assert ("TransportStress" in kept) == ("stress" in kw.get("corrections", ("stress",)))
+    on = kw.get("corrections", ("edac", "stress", "divergence"))
+    assert ("EDACTransportCorrection" in kept) == ("edac" in on)
+    assert ("TransportStress" in kept) == ("stress" in on)
+    assert ("MomentumTransportDivergence" in kept) == ("divergence" in on)
     if kw.get("density") == "continuity":
         assert {"TransportContinuity", "ContinuityTransportCorrection"} <= kept
     if kw["shifting"] == "ipst":
         assert {"IPSTStart", "IPSTShift", "IPSTAcceleration"} <= kept
+        assert ("ZeroHomogenisation" in kept) == (kw.get("ipst_interval", 1) > 1)
     assert sorted(a.data) == sorted(b.data)
     for name in a.data:
         assert_close(a.data[name], b.data[name], 1e-11, what=f"{kw}: {name}")
     assert np.abs(a.ap).max() > 0 and np.abs(a.auhat).max() > 0
+    if dim == 3:
+        assert np.abs(a.aw).max() > 0 and np.abs(a.awhat).max() > 0
 
 
 # -------------------------------------------------- correction terms vs analytic values
