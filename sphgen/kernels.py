@@ -84,7 +84,53 @@ class QuinticSpline(Kernel):
         return -(self.dim * self.w(rij, h) + rij * self.dwdr(rij, h))
 
 
-KERNELS = {"quintic": QuinticSpline}
+class WendlandQuinticC2(Kernel):
+    """Wendland C2 ("quintic"), support 2h: W = a_d/h^d (1 - q/2)^4 (1 + 2q)
+    (Wendland 1995; Kincl et al. (2025), sec. 2, with the (1 + 2q) factor that
+    normalises, where the thesis' eq. 1.6 prints (1 + 4q))."""
+
+    radius_scale = 2.0
+    name = "wendland"
+    methods = ("sigma", "w", "dwdr", "gradh")
+
+    def __init__(self, dim):
+        super().__init__(dim)
+        self.fac = {1: 0.75, 2: 7.0 / (4.0 * pi), 3: 21.0 / (16.0 * pi)}[dim]
+
+    def sigma(self, h=1.0):
+        """Normalisation a_d / h^dim."""
+        hi = 1.0 / h
+        s = self.fac * hi
+        if self.dim > 1:
+            s = s * hi
+        if self.dim > 2:
+            s = s * hi
+        return s
+
+    def w(self, rij=1.0, h=1.0):
+        """W(r, h) = a_d/h^d (1 - q/2)^4 (1 + 2q) for q = r/h < 2."""
+        q = rij / h
+        val = 0.0
+        if q < 2.0:
+            t = 1.0 - 0.5 * q
+            val = t * t * t * t * (1.0 + 2.0 * q)
+        return self.sigma(h) * val
+
+    def dwdr(self, rij=1.0, h=1.0):
+        """dW/dr = -5 a_d/h^(d+1) q (1 - q/2)^3 for q < 2."""
+        q = rij / h
+        val = 0.0
+        if q < 2.0:
+            t = 1.0 - 0.5 * q
+            val = -5.0 * q * t * t * t
+        return self.sigma(h) * val / h
+
+    def gradh(self, rij=1.0, h=1.0):
+        """h dW/dh = -(d W + r dW/dr)."""
+        return -(self.dim * self.w(rij, h) + rij * self.dwdr(rij, h))
+
+
+KERNELS = {"quintic": QuinticSpline, "wendland": WendlandQuinticC2}
 
 
 def get_kernel(name, dim):

@@ -179,7 +179,7 @@ def _plot_precision(path, axes, rows, key, ref):
     groups = {}
     for r in rows:
         pairs = list(zip(r["args"][::2], r["args"][1::2]))[:len(axes)]
-        label = ", ".join(f"{o} {v}" for i, (o, v) in enumerate(pairs) if i != along) or "sphgen"
+        label = ", ".join(f"{o} {v}" for i, (o, v) in enumerate(pairs) if i != along)
         groups.setdefault(label, []).append((r, pairs[along][1] if along is not None else ""))
     for label, members in groups.items():
         ok = [(m["info"]["wall_time"], m["results"][key], v) for m, v in members

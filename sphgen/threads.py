@@ -5,7 +5,9 @@ another process shares the cores, one of our threads is descheduled for a time s
 (milliseconds) and the whole pass waits: on 2 busy cores 2 threads ran 4x slower than one.
 :class:`ThreadTuner` times steps with the requested threads and with one thread, keeps
 the faster, and checks again at growing intervals (short again as soon as the choice
-flips, since load comes and goes).  The loops compute each particle independently, so
+flips, since load comes and goes).  A trial that is clearly losing after its first
+``early`` steps (every one slower than ``1 / margin`` of the current median) ends there,
+so that on an idle machine the trials cost a few serial steps, not ``trial`` of them.  The loops compute each particle independently, so
 the choice never changes the results.
 """
 import statistics
@@ -14,10 +16,11 @@ import statistics
 class ThreadTuner:
     """Chooses, step by step, between ``scene.threads`` threads and one."""
 
-    def __init__(self, scene, trial=6, first=12, longest=3200):
+    def __init__(self, scene, trial=6, first=20, longest=3200, early=2, margin=0.8):
         self.scene = scene
         self.most = scene.threads
         self.trial, self.first, self.longest = trial, first, longest
+        self.early, self.margin = early, margin
         self.current = self.most
         self.every = first
         self._times = []          # step times of the current run phase
@@ -34,8 +37,11 @@ class ThreadTuner:
         if not self.active:
             return
         if self._trying is not None:
-            self._trying[1].append(seconds)
-            if len(self._trying[1]) >= self.trial:
+            times = self._trying[1]
+            times.append(seconds)
+            losing = (len(times) == self.early
+                      and min(times) * self.margin > statistics.median(self._times))
+            if len(times) >= self.trial or losing:
                 self._decide(step)
             return
         self._times = (self._times + [seconds])[-self.trial:]

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from sphgen.kernels import QuinticSpline, get_kernel
+from sphgen.kernels import QuinticSpline, WendlandQuinticC2, get_kernel
 
 
 @pytest.mark.parametrize("dim", [1, 2, 3])
@@ -27,5 +27,24 @@ def test_quintic_derivatives_match_finite_differences(dim):
 
 
 def test_unknown_kernel_is_a_clear_error():
-    with pytest.raises(ValueError, match="unknown kernel 'cubic'; known: quintic"):
+    with pytest.raises(ValueError, match="unknown kernel 'cubic'; known: quintic, wendland"):
         get_kernel("cubic", 2)
+
+
+@pytest.mark.parametrize("dim", [1, 2, 3])
+def test_wendland_normalisation_derivatives_and_values(dim):
+    k = WendlandQuinticC2(dim)
+    r = np.linspace(0.0, 2.0, 20001)
+    w = np.array([k.w(x, 1.0) for x in r])
+    surface = {1: 2.0, 2: 2 * np.pi * r, 3: 4 * np.pi * r ** 2}[dim]
+    assert abs(np.trapezoid(w * surface, r) - 1.0) < 1e-6
+    h, e = 0.7, 1e-6
+    for x in np.linspace(0.05, 1.95, 30):
+        fd = (k.w(x + e, h) - k.w(x - e, h)) / (2 * e)
+        assert abs(k.dwdr(x, h) - fd) < 1e-6 * max(1.0, abs(fd)) / h ** (dim + 1)
+        fdh = h * (k.w(x, h + e) - k.w(x, h - e)) / (2 * e)
+        assert abs(k.gradh(x, h) - fdh) < 1e-5 / h ** dim
+    # w(0) = a_d and h dW/dh(0) = -d a_d (Kincl et al. digest, unit-test values)
+    assert k.w(0.0, 1.0) == pytest.approx(k.fac, rel=1e-15)
+    assert k.gradh(0.0, 1.0) == pytest.approx(-dim * k.fac, rel=1e-15)
+    assert k.w(2.0 * (1 + 1e-12), 1.0) == 0.0 and k.dwdr(2.0 * (1 + 1e-12), 1.0) == 0.0

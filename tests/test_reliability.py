@@ -182,12 +182,32 @@ def test_thread_tuner_drops_to_one_thread_under_load_and_returns():
     cost = {2: 4.0, 1: 1.0}          # loaded machine: 2 threads 4x slower than one
     for step in range(1, 40):
         tuner.record(step, cost[scene.threads])
-    assert scene.threads == 1 and tuner.choices[0][1] == 1
+    assert tuner.current == 1 and tuner.choices[0][1] == 1
     cost = {2: 0.55, 1: 1.0}         # load gone: 2 threads 1.8x faster
     for step in range(40, 200):
         tuner.record(step, cost[scene.threads])
-    assert scene.threads == 2 and tuner.choices[-1][1] == 2
+    assert tuner.current == 2 and tuner.choices[-1][1] == 2
     n_trials = len(tuner.choices)
     for step in range(200, 2000):    # steady: trials become rare (intervals double)
         tuner.record(step, cost[scene.threads])
     assert tuner.every > 200 and len(tuner.choices) == n_trials
+
+
+def test_thread_tuner_abandons_a_clearly_losing_trial_early():
+    from sphgen.threads import ThreadTuner
+
+    class FakeScene:
+        threads = 2
+
+        def set_threads(self, n):
+            self.threads = n
+
+    scene = FakeScene()
+    tuner = ThreadTuner(scene, trial=6, first=20, early=2)
+    serial_steps = 0
+    for step in range(1, 1001):      # idle machine: one thread 1.8x slower
+        serial_steps += scene.threads == 1
+        tuner.record(step, {2: 1.0, 1: 1.8}[scene.threads])
+    assert tuner.choices == []
+    # trials after 20, 40, 80, 160, 320 steps of two threads: two serial steps each
+    assert serial_steps == 2 * 5
