@@ -1,8 +1,8 @@
-"""Taylor-Green vortex in a periodic unit box (seed 002 section 3.1).
+"""Taylor-Green vortex in a periodic unit box (Adepu & Ramachandran (2024) section 3.1).
 
 u = -U e^{bt} cos(2 pi x) sin(2 pi y), v = U e^{bt} sin(2 pi x) cos(2 pi y),
 p = -U^2 e^{2bt} (cos(4 pi x) + cos(4 pi y)) / 4, b = -8 pi^2 / Re.
-``post_process`` writes results.json (L1 error of |u|, seed 002 eq. 66; max |u| and
+``post_process`` writes results.json (L1 error of |u|, Adepu & Ramachandran (2024) eq. 66; max |u| and
 its exact decay) and a plot of both over time.
 
 ``--scheme`` picks EDAC (the default; the uncorrected baseline), CTVF (Adepu &
@@ -40,7 +40,7 @@ def exact_velocity(x, y, t, re, U=1.0):
 
 
 def l1_error(x, y, u, v, t, re):
-    """sum_i | |u_i| - |u_ex(x_i, t)| | / sum_i |u_ex(x_i, t)| (seed 002 eq. 66)."""
+    """sum_i | |u_i| - |u_ex(x_i, t)| | / sum_i |u_ex(x_i, t)| (Adepu & Ramachandran (2024) eq. 66)."""
     ue, ve = exact_velocity(x, y, t, re)
     vmag, emag = np.hypot(u, v), np.hypot(ue, ve)
     return float(np.abs(vmag - emag).sum() / emag.sum())
@@ -236,7 +236,7 @@ class TaylorGreen(Application):
         a.legend()
         b.plot(t, l1, "b-")
         b.set_xlabel("t")
-        b.set_ylabel("$L_1$ error of |u| (seed 002 eq. 66)")
+        b.set_ylabel("$L_1$ error of |u| (Adepu & Ramachandran (2024) eq. 66)")
         fig.tight_layout()
         fig.savefig(os.path.join(outdir, "decay.png"), dpi=100)
         plt.close(fig)

@@ -1,6 +1,6 @@
-"""Taylor-Green vortex, EDAC reference scheme (uncorrected baseline of seed 002, sec. 3.1).
+"""Taylor-Green vortex, EDAC reference scheme (uncorrected baseline of Adepu & Ramachandran (2024), sec. 3.1).
 
-Figures (named after seed 002 Fig. 6, which shows the corrected scheme; these are the
+Figures (named after Adepu & Ramachandran (2024) Fig. 6, which shows the corrected scheme; these are the
 uncorrected EDAC baseline with SPST): ``tg_edac_decay.png`` (max |u| against the exact
 decay for nx = 25, 50, 100) and ``tg_edac_l1.png`` (L1 error of |u|, eq. 66, over time).
 """

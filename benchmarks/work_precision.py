@@ -1,5 +1,5 @@
 #!/usr/bin/env python
-"""Work-precision: L1 error of |u| (seed 002 eq. 66) against wall time, Taylor-Green EDAC.
+"""Work-precision: L1 error of |u| (Adepu & Ramachandran (2024) eq. 66) against wall time, Taylor-Green EDAC.
 
 For nx in 25, 50, 100 (Re=100, tf=0.5) runs sphgen (2 threads) and, where a PySPH venv
 is found, PySPH 1.0b2's EDAC; prints a table and writes a log-log plot.  Both the

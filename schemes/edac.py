@@ -103,7 +103,7 @@ class EDACScheme(Scheme):
         self.rho0, self.c0, self.nu, self.h, self.dx, self.umax = rho0, c0, nu, h, dx, umax
         self.pst, self.alpha, self.alpha_edac = pst, alpha, alpha_edac
         self.mach = umax / c0 if mach is None else mach
-        # the KDK transport velocity u + dt/2 a_c (seed 002 eq. 55) with p_b = 2 rho0 c0^2
+        # the KDK transport velocity u + dt/2 a_c (Adepu & Ramachandran (2024) eq. 55) with p_b = 2 rho0 c0^2
         # equals Adami et al.'s u + dt a_c with their p_b = rho0 c0^2
         self.pb = 2.0 * rho0 * c0 * c0 if pb is None else pb
         self.bql = bool(bql)
@@ -126,7 +126,7 @@ class EDACScheme(Scheme):
 
     def get_equations(self):
         f = self.fluids
-        nu_edac = self.alpha_edac * self.h * self.c0 / 8.0  # seed 002 eq. 24
+        nu_edac = self.alpha_edac * self.h * self.c0 / 8.0  # Adepu & Ramachandran (2024) eq. 24
         shift = self.pst != "none"
         w, fw = self.walls, self.fluids + self.walls
         pressure = []

@@ -108,7 +108,7 @@ class Integrator:
 
 
 class KickDriftKick(Integrator):
-    """Kick-drift-kick Verlet (seed 002 eqs. 54-60): two equation sets per step.
+    """Kick-drift-kick Verlet (Adepu & Ramachandran (2024) eqs. 54-60): two equation sets per step.
 
     stage1 kick (t^n -> half step), evaluation 0 at r^n, stage2 drift, neighbour
     update, evaluation 1 at r^{n+1}, stage3 kick.  Evaluation 1 also runs once before

@@ -11,7 +11,7 @@ from conftest import lattice_cloud, periodic_box
 
 @pytest.mark.parametrize("pst,alpha", [("none", 0.5), ("sun2019", 0.0), ("tvf", 0.2)])
 def test_linear_momentum_is_conserved_in_a_periodic_run(pst, alpha):
-    """Seed 002 eq. 27 (bql off) is antisymmetric pair by pair: sum m u stays put."""
+    """Adepu & Ramachandran (2024) eq. 27 (bql off) is antisymmetric pair by pair: sum m u stays put."""
     pa = lattice_cloud(nx=16, jitter=0.3, seed=7)
     rng = np.random.default_rng(1)
     pa.add_property("p", data=rng.uniform(-1, 1, pa.n))
@@ -47,7 +47,7 @@ def test_adaptive_time_step_follows_the_limits_equations_write():
     integ = s.get_integrator()
     sc = Scene([pa], eqs, steppers=integ.steppers, kernel=s.kernel, dim=2, domain=periodic_box(2),
                outputs={"fluid": list(s.output_props) + ["dt_cfl"]})
-    # the equation writes the three limits of seed 002 eq. 61 per particle
+    # the equation writes the three limits of Adepu & Ramachandran (2024) eq. 61 per particle
     sc.compute(1, 0.0, 1e-3)
     speed, acc = np.hypot(pa.u, pa.v), np.hypot(pa.au, pa.av)
     lim = np.minimum(dx / (10.0 + speed), dx * dx / 0.05)
