@@ -20,6 +20,16 @@ class Kernel:
             raise ValueError(f"kernel dimension must be 1, 2 or 3, got {dim!r}")
         self.dim = dim
 
+    def sigma(self, h=1.0):
+        """Normalisation fac / h^dim (fac: the kernel's constant for this dimension)."""
+        hi = 1.0 / h
+        s = self.fac * hi
+        if self.dim > 1:
+            s = s * hi
+        if self.dim > 2:
+            s = s * hi
+        return s
+
     def constants(self):
         """Attributes folded into the generated code."""
         return {"dim": self.dim, "fac": self.fac}
@@ -38,16 +48,6 @@ class QuinticSpline(Kernel):
     def __init__(self, dim):
         super().__init__(dim)
         self.fac = {1: 1.0 / 120.0, 2: 7.0 / (478.0 * pi), 3: 1.0 / (120.0 * pi)}[dim]
-
-    def sigma(self, h=1.0):
-        """Normalisation sigma / h^dim."""
-        hi = 1.0 / h
-        s = self.fac * hi
-        if self.dim > 1:
-            s = s * hi
-        if self.dim > 2:
-            s = s * hi
-        return s
 
     def w(self, rij=1.0, h=1.0):
         """W(r, h) = sigma/h^d [(3-q)^5 - 6(2-q)^5 + 15(1-q)^5] on the pieces of q = r/h."""
@@ -96,16 +96,6 @@ class WendlandQuinticC2(Kernel):
     def __init__(self, dim):
         super().__init__(dim)
         self.fac = {1: 0.75, 2: 7.0 / (4.0 * pi), 3: 21.0 / (16.0 * pi)}[dim]
-
-    def sigma(self, h=1.0):
-        """Normalisation a_d / h^dim."""
-        hi = 1.0 / h
-        s = self.fac * hi
-        if self.dim > 1:
-            s = s * hi
-        if self.dim > 2:
-            s = s * hi
-        return s
 
     def w(self, rij=1.0, h=1.0):
         """W(r, h) = a_d/h^d (1 - q/2)^4 (1 + 2q) for q = r/h < 2."""
