@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from sphgen import io
+from sphgen.threads import ThreadTuner
 from sphgen.app import load_application, main
 from sphgen.equation import ParameterError
 from sphgen.errors import BlowUpError, RestartError
@@ -168,16 +169,16 @@ def test_ctrl_c_writes_the_last_complete_step(tmp_path):
     assert json.load(open(tmp_path / "info.json"))["completed"] is False
 
 
+class _TwoThreadScene:
+    """What ThreadTuner needs of a scene: its thread count and a way to set it."""
+    threads = 2
+
+    def set_threads(self, n):
+        self.threads = n
+
+
 def test_thread_tuner_drops_to_one_thread_under_load_and_returns():
-    from sphgen.threads import ThreadTuner
-
-    class FakeScene:
-        threads = 2
-
-        def set_threads(self, n):
-            self.threads = n
-
-    scene = FakeScene()
+    scene = _TwoThreadScene()
     tuner = ThreadTuner(scene, trial=3, first=4)
     cost = {2: 4.0, 1: 1.0}          # loaded machine: 2 threads 4x slower than one
     for step in range(1, 40):
@@ -194,15 +195,7 @@ def test_thread_tuner_drops_to_one_thread_under_load_and_returns():
 
 
 def test_thread_tuner_abandons_a_clearly_losing_trial_early():
-    from sphgen.threads import ThreadTuner
-
-    class FakeScene:
-        threads = 2
-
-        def set_threads(self, n):
-            self.threads = n
-
-    scene = FakeScene()
+    scene = _TwoThreadScene()
     tuner = ThreadTuner(scene, trial=6, first=20, early=2)
     serial_steps = 0
     for step in range(1, 1001):      # idle machine: one thread 1.8x slower
