@@ -1,8 +1,10 @@
-"""Smoothing kernels as translatable code: w, dw/dr, h dw/dh.
+"""Smoothing kernels as translatable code: w, dw/dr, h dw/dh, (h/r) d2w/(dr dh).
 
-A kernel is a class whose methods ``w(rij, h)``, ``dwdr(rij, h)`` and ``gradh(rij, h)``
-are restricted Python.  Its attributes (``dim``, ``fac``) are folded into the generated
-code as constants, so the compiled kernel is specialised on the dimension.
+A kernel is a class whose methods ``w(rij, h)``, ``dwdr(rij, h)``, ``gradh(rij, h)`` and
+``mixed(rij, h)`` are restricted Python.  Its attributes (``dim``, ``fac``) are folded into
+the generated code as constants, so the compiled kernel is specialised on the dimension.
+``methods`` go into every module; ``extra_methods`` only into a module whose equations ask
+for a pair symbol that calls them (``MIXEDIJ``).
 """
 from math import pi
 
@@ -14,6 +16,7 @@ class Kernel:
     name = "kernel"
     # translated into the scene module in this order (a method may call earlier ones)
     methods = ("w", "dwdr", "gradh")
+    extra_methods = ()
 
     def __init__(self, dim):
         if dim not in (1, 2, 3):
@@ -44,6 +47,7 @@ class QuinticSpline(Kernel):
     radius_scale = 3.0
     name = "quintic"
     methods = ("sigma", "w", "dwdr", "gradh")
+    extra_methods = ("d2wdr2", "mixed")
 
     def __init__(self, dim):
         super().__init__(dim)
@@ -83,6 +87,29 @@ class QuinticSpline(Kernel):
         """h dW/dh = -(d W + r dW/dr)."""
         return -(self.dim * self.w(rij, h) + rij * self.dwdr(rij, h))
 
+    def d2wdr2(self, rij=1.0, h=1.0):
+        """d2W/dr2 = 20 sigma/h^(d+2) [(3-q)^3 - 6(2-q)^3 + 15(1-q)^3] on the pieces of q."""
+        q = rij / h
+        a = 3.0 - q
+        b = 2.0 - q
+        c = 1.0 - q
+        val = 0.0
+        if q < 1.0:
+            val = a * a * a - 6.0 * b * b * b + 15.0 * c * c * c
+        elif q < 2.0:
+            val = a * a * a - 6.0 * b * b * b
+        elif q < 3.0:
+            val = a * a * a
+        return 20.0 * self.sigma(h) * val / (h * h)
+
+    def mixed(self, rij=1.0, h=1.0):
+        """(h/r) d2W/(dr dh) = -((d + 1) W'/r + W''); the gradient of h dW/dh is this times x_ij.
+
+        At r -> 0, W'/r -> W''(0), so the value there is -(d + 2) W''(0)."""
+        if rij < 1e-12 * h:
+            return -(self.dim + 2.0) * self.d2wdr2(0.0, h)
+        return -((self.dim + 1.0) * self.dwdr(rij, h) / rij + self.d2wdr2(rij, h))
+
 
 class WendlandQuinticC2(Kernel):
     """Wendland C2 ("quintic"), support 2h: W = a_d/h^d (1 - q/2)^4 (1 + 2q)
@@ -92,6 +119,7 @@ class WendlandQuinticC2(Kernel):
     radius_scale = 2.0
     name = "wendland"
     methods = ("sigma", "w", "dwdr", "gradh")
+    extra_methods = ("mixed",)
 
     def __init__(self, dim):
         super().__init__(dim)
@@ -118,6 +146,20 @@ class WendlandQuinticC2(Kernel):
     def gradh(self, rij=1.0, h=1.0):
         """h dW/dh = -(d W + r dW/dr)."""
         return -(self.dim * self.w(rij, h) + rij * self.dwdr(rij, h))
+
+    def mixed(self, rij=1.0, h=1.0):
+        """(h/r) d2W/(dr dh) = 5 a_d/h^(d+2) (1 - q/2)^2 ((d + 2) - (d + 5) q/2) for q < 2.
+
+        The gradient of h dW/dh is this times x_ij, so no division by r is needed.  In 2D it
+        is -35/(8 pi h^4) (1 - q/2)^2 (7q - 8): Kincl et al. (2023), sec. 3.5, print 35/(4 pi h^4),
+        twice too large; their 3D formula -105/(16 pi h^5) (1 - q/2)^2 (4q - 5) agrees with this.
+        """
+        q = rij / h
+        val = 0.0
+        if q < 2.0:
+            t = 1.0 - 0.5 * q
+            val = 5.0 * t * t * ((self.dim + 2.0) - 0.5 * (self.dim + 5.0) * q)
+        return self.sigma(h) * val / (h * h)
 
 
 KERNELS = {"quintic": QuinticSpline, "wendland": WendlandQuinticC2}

@@ -77,3 +77,34 @@ def test_wendland_in_generated_code_matches_brute_force(backend):
     assert np.abs(q).max() > 0 and np.abs(gx).max() > 0
     assert np.allclose(pa.q, q, rtol=1e-12, atol=1e-13)
     assert np.allclose(pa.gx, gx, rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize("name", ["wendland", "quintic"])
+@pytest.mark.parametrize("dim", [1, 2, 3])
+def test_mixed_derivative_matches_finite_differences_of_gradh(name, dim):
+    """(h/r) d2W/(dr dh) = (1/r) d/dr (h dW/dh): the penalty force of Kincl et al. (2023) eq. 21."""
+    k = get_kernel(name, dim)
+    h, e = 0.7, 1e-6
+    R = k.radius_scale * h
+    for r in np.linspace(0.03, 0.98, 40) * R:
+        fd = (k.gradh(r + e, h) - k.gradh(r - e, h)) / (2 * e) / r
+        assert abs(k.mixed(r, h) - fd) < 1e-6 * max(1.0, abs(fd)) / h ** (dim + 2)
+    # continuous at r = 0 and zero outside the support
+    assert k.mixed(0.0, h) == pytest.approx(k.mixed(1e-7 * h, h), rel=1e-6)
+    assert k.mixed(R * (1 + 1e-12), h) == 0.0
+
+
+def test_wendland_mixed_derivative_values_of_the_paper():
+    """2D: -35/(8 pi h^4)(1-q/2)^2 (7q-8) (the paper prints 35/(4 pi), twice too large);
+    3D: -105/(16 pi h^5)(1-q/2)^2 (4q-5) as printed; zeros at q = 8/7 and 5/4."""
+    h = 1.3
+    for q in np.linspace(0.0, 1.99, 25):
+        t = 1 - q / 2
+        assert WendlandQuinticC2(2).mixed(q * h, h) == pytest.approx(
+            -35 / (8 * np.pi * h ** 4) * t * t * (7 * q - 8), rel=1e-12, abs=1e-15)
+        assert WendlandQuinticC2(3).mixed(q * h, h) == pytest.approx(
+            -105 / (16 * np.pi * h ** 5) * t * t * (4 * q - 5), rel=1e-12, abs=1e-15)
+    assert WendlandQuinticC2(2).mixed(8 / 7 * h, h) == pytest.approx(0.0, abs=1e-14)
+    assert WendlandQuinticC2(3).mixed(1.25 * h, h) == pytest.approx(0.0, abs=1e-14)
+    assert WendlandQuinticC2(2).mixed(0.0, 1.0) == pytest.approx(35 / np.pi, rel=1e-14)
+    assert WendlandQuinticC2(3).mixed(0.0, 1.0) == pytest.approx(525 / (16 * np.pi), rel=1e-14)

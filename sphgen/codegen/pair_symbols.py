@@ -25,6 +25,7 @@ class PairSymbol:
     vector: bool = False   # a double[3] whose components past the dimension stay 0
     scratch: tuple = ()    # local doubles its Cython uses
     cost: int = 1          # floating-point operations per pair, roughly
+    kernel_methods: tuple = ()   # kernel ``extra_methods`` its Cython calls
 
     @property
     def dtype(self):
@@ -139,10 +140,10 @@ def _dwij_python(p):
     return [f * x for x in p["XIJ"]]
 
 
-def _kernel_row(name, method, doc, cost):
-    """A row that evaluates a kernel method at (RIJ, HIJ)."""
+def _kernel_row(name, method, doc, cost, extra=False):
+    """A row that evaluates a kernel method at (RIJ, HIJ) (``extra``: one of its extra_methods)."""
     return PairSymbol(
-        name, doc, cost=cost, depends=("RIJ", "HIJ"),
+        name, doc, cost=cost, depends=("RIJ", "HIJ"), kernel_methods=(method,) if extra else (),
         cython=lambda c: [f"{name} = kernel_{method}(RIJ, HIJ)"],
         python=lambda p: getattr(p.kernel, method)(p["RIJ"], p["HIJ"]))
 
@@ -165,6 +166,8 @@ ROWS = (
     _kernel_row("WIJ", "w", "W(r_ij, h_ij)", 30),
     _kernel_row("WDASHIJ", "dwdr", "dW/dr at (r_ij, h_ij)", 30),
     _kernel_row("GHIJ", "gradh", "h dW/dh at (r_ij, h_ij)", 60),
+    _kernel_row("MIXEDIJ", "mixed", "(h/r) d2W/(dr dh) at (r_ij, h_ij): grad_i (h dW/dh) = MIXEDIJ x_ij",
+                40, extra=True),
     PairSymbol("DWIJ", "grad_i W = W'(r_ij) x_ij / r_ij (0 at r = 0)", vector=True, cost=5,
                depends=("WDASHIJ", "RIJ", "XIJ"), scratch=("_f",),
                cython=lambda c: ["_f = WDASHIJ / RIJ if RIJ > 1e-12 else 0.0"] +
@@ -197,6 +200,11 @@ def closure(requested):
 def properties(requested, pair):
     """Properties (on destination and sources) the requested symbols read, given a pair."""
     return {p for name in closure(requested) for p in SYMBOLS[name].props(pair)}
+
+
+def kernel_methods(symbols):
+    """The kernel extra methods the given symbols call."""
+    return {m for name in symbols for m in SYMBOLS[name].kernel_methods}
 
 
 def cost(requested):

@@ -1,6 +1,7 @@
 """Pass: the functions the compiled module defines, in order, and their run-time parameters."""
+from .. import pair_symbols
 from ..plan import FunctionPlan
-from ..translate import specialise
+from ..translate import TranslationError, specialise
 
 
 def _module_globals(fp):
@@ -11,10 +12,18 @@ def _module_globals(fp):
 
 
 def collect_functions(plan):
-    """Kernel methods; then each pass's methods (first use wins); then the stage methods."""
+    """Kernel methods (the extra ones if a chosen pair symbol calls one); then each pass's
+    methods (first use wins); then the stage methods."""
     kernel = plan.kernel
+    asked = pair_symbols.kernel_methods(s for p in plan.neighbour_passes() for loop in p.sources
+                                        for s in loop.symbols)
+    missing = sorted(asked - set(kernel.extra_methods))
+    if missing:
+        raise TranslationError(f"a pair symbol of this scene needs the kernel method '{missing[0]}', "
+                               f"which {type(kernel).__name__} does not have")
+    methods = tuple(kernel.methods) + (tuple(kernel.extra_methods) if asked else ())
     plan.kernel_functions = [specialise(kernel, m, kernel.constants(), "kernel", keep_defaults=True)
-                             for m in kernel.methods]
+                             for m in methods]
     funcs = {}
     for p in plan.neighbour_passes():
         for ep in p.equations:

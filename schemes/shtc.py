@@ -1,0 +1,307 @@
+"""SHTC-SPH: one scheme for elastic solids and viscous fluids (Kincl, Peshkov, Pavelka & Klika
+(2023), "Unified description of fluids and solids in Smoothed Particle Hydrodynamics").
+
+State per particle: position, velocity and the distortion A (3x3, stride 9, also in 2D).
+Density by kernel summation with a constant that makes rho = rho0 at t = 0 (eq. 4); the
+renormalised velocity gradient L = (sum m v_ab (x) grad w) H^-1 (eq. 7); the force
+sum_b m_b (T_a + T_b) grad w_ab with T = -p/rho^2 I + A^T eps_A H^-1 (eqs. 10-12, 16, 18);
+the tensile penalty of eqs. 19-21 (``cp``); strain relaxation with time tau (eq. 24c).
+
+Time step (eqs. 23, 25), :class:`SHTCIntegrator`:
+
+#. kick v += dt/2 a (stage1); drift x += dt/2 v (stage2); neighbour update;
+#. evaluation 0 at the half step: H and L (eq. 7);
+#. stage3: A* = A (I - dt/2 L)(I + dt/2 L)^-1 (Cayley), RK4 relaxation of A* over dt if
+   tau < infinity (eq. 25d), drift x += dt/2 v; neighbour update;
+#. evaluation 1: rho, lambda, H, then p and T; then the force;
+#. kick v += dt/2 a (stage4).
+
+Evaluation 2 runs once before the first step: the masses (``masses='kernel'``: m = rho0 /
+sum_b w_ab, the paper's sec. 3.1; ``'lattice'``: the masses given), then the constants C_rho
+and C_lambda.  Walls (dummy particles) carry their own A, rho, lambda and T and run the
+same equations (they enter the bodies' sums and forces through T_b and lambda_b); their
+positions and velocities are prescribed (``Integrator.add_motion``), never integrated, and
+their A is updated from their own L.  A lid's prescribed velocity therefore enters only L.
+"""
+import math
+
+import numpy as np
+
+from sphgen.equation import Group
+from sphgen.errors import InputError
+from sphgen.integrators import Integrator, IntegratorStep
+from sphgen.kernels import get_kernel
+from sphgen.scheme import Bound, Scheme
+
+from ..equations.shtc_density import DensityConstant, KernelVolumeMass, SummationDensityWithConstant
+from ..equations.shtc_distortion import cayley_update
+from ..equations.shtc_penalty import PenaltyLambda, PenaltyLambdaConstant, TensilePenaltyForce
+from ..equations.shtc_relaxation import relax_rk4
+from ..equations.shtc_stress import MODELS, SHTCMomentum, SHTCStress
+from ..equations.shtc_velocity_gradient import KernelMoment, RenormalisedVelocityGradient
+from sphgen.equation import declare
+
+RK4_REAL_STABILITY = 2.785293563405282
+"""|z| where classical RK4's stability region meets the negative real axis."""
+
+RELAXATION_DT_LIMIT = RK4_REAL_STABILITY / 6.0
+"""dt/tau bound of the explicit RK4 relaxation: the stiffest rate at A = I is 6/tau (0.4642)."""
+
+THETA_DETPOW = 5.0 / 3.0
+"""theta = tau cs^2/3 |det A|^(-5/3) (paper footnote 1; thesis eq. 2.11)."""
+
+
+class SHTCStep(IntegratorStep):
+    """Per-particle stages of the SHTC-SPH step (Kincl et al. (2023), eqs. 25a-f).
+
+    ``move`` = 0 for walls: only A is updated (stage3), positions and velocities are
+    prescribed.  ``rate`` = 3/tau (0 for tau = infinity removes the relaxation from the code),
+    ``detpow`` the power of |det A| in 1/theta (0: the paper's choice).
+    """
+
+    switches = ("dim", "model", "rate", "detpow", "move")
+
+    def __init__(self, dim, model=0, rate=0.0, detpow=0.0, move=True):
+        self.dim, self.model, self.move = int(dim), int(model), int(move)
+        self.rate, self.detpow = float(rate), float(detpow)
+
+    def stage1(self, d_idx, d_u, d_v, d_w, d_au, d_av, d_aw, dt):
+        """Kick v += dt/2 a (eq. 25a)."""
+        if self.move:
+            d_u[d_idx] += 0.5 * dt * d_au[d_idx]
+            if self.dim > 1:
+                d_v[d_idx] += 0.5 * dt * d_av[d_idx]
+            if self.dim > 2:
+                d_w[d_idx] += 0.5 * dt * d_aw[d_idx]
+
+    def stage2(self, d_idx, d_x, d_y, d_z, d_u, d_v, d_w, dt):
+        """Drift x += dt/2 v (eq. 25b)."""
+        if self.move:
+            d_x[d_idx] += 0.5 * dt * d_u[d_idx]
+            if self.dim > 1:
+                d_y[d_idx] += 0.5 * dt * d_v[d_idx]
+            if self.dim > 2:
+                d_z[d_idx] += 0.5 * dt * d_w[d_idx]
+
+    def stage3(self, d_idx, d_x, d_y, d_z, d_u, d_v, d_w, d_A, d_L, dt):
+        """A by the Cayley transform (eq. 25c), RK4 relaxation (eq. 25d); drift (eq. 25e)."""
+        a = declare("matrix(9)")
+        l = declare("matrix(9)")
+        b = declare("matrix(9)")
+        for i in range(9):
+            a[i] = d_A[9 * d_idx + i]
+            l[i] = d_L[9 * d_idx + i]
+        cayley_update(a, l, dt, b)
+        if self.rate != 0.0:
+            relax_rk4(b, dt, self.rate, self.model, self.detpow)
+        for i in range(9):
+            d_A[9 * d_idx + i] = b[i]
+        if self.move:
+            d_x[d_idx] += 0.5 * dt * d_u[d_idx]
+            if self.dim > 1:
+                d_y[d_idx] += 0.5 * dt * d_v[d_idx]
+            if self.dim > 2:
+                d_z[d_idx] += 0.5 * dt * d_w[d_idx]
+
+    def stage4(self, d_idx, d_u, d_v, d_w, d_au, d_av, d_aw, dt):
+        """Kick v += dt/2 a (eq. 25f)."""
+        if self.move:
+            d_u[d_idx] += 0.5 * dt * d_au[d_idx]
+            if self.dim > 1:
+                d_v[d_idx] += 0.5 * dt * d_av[d_idx]
+            if self.dim > 2:
+                d_w[d_idx] += 0.5 * dt * d_aw[d_idx]
+
+
+class SHTCIntegrator(Integrator):
+    """Verlet for (x, v), the mid-point (Cayley) rule for A and RK4 relaxation (Kincl et al.
+    (2023), eqs. 23 and 25), with two neighbour-list builds per step as in the paper.
+
+    Equation sets: 0 = L at the half step, 1 = state and force at the full step, 2 = the
+    start-up (masses, C_rho, C_lambda), run once before evaluation 1 at t = 0.
+    """
+
+    n_evaluations = 3
+    position_time = {"stage1": 0.0, "stage2": 0.5, "stage3": 1.0, "stage4": 1.0}
+
+    def initial_accelerations(self, t, dt):
+        self.compute_accelerations(2, t, dt)
+        self.compute_accelerations(1, t, dt)
+
+    def one_timestep(self, t, dt):
+        self.stage("stage1", t, dt)
+        self.stage("stage2", t, dt)
+        self.update_nnps()
+        self.compute_accelerations(0, t + 0.5 * dt, dt)
+        self.stage("stage3", t, dt)
+        self.update_nnps()
+        self.compute_accelerations(1, t + dt, dt)
+        self.stage("stage4", t + dt, dt)
+
+
+def identity_tensors(n):
+    """n identity 3x3 tensors, flat (the initial distortion)."""
+    return np.tile(np.eye(3).ravel(), n)
+
+
+class SHTCScheme(Scheme):
+    """SHTC-SPH of Kincl, Peshkov, Pavelka & Klika (2023) for solids and fluids.
+
+    ``bodies``: arrays integrated in time (solid or fluid); ``walls``: dummy-particle arrays
+    with prescribed motion (``moving_walls`` among them carry velocities: lids, rotating
+    walls).  Material: ``rho0``, bulk sound speed ``c0``, shear sound speed ``cs``, strain
+    relaxation time ``tau`` (``math.inf``: elastic solid; a Newtonian fluid of kinematic
+    viscosity nu has tau = 6 nu/cs^2, eq. 29), ``model`` 'dprz' (eq. 15) or 'neo-hookean'
+    (eq. 17), tensile penalty velocity ``cp`` (0 removes it).  Numerics: smoothing length
+    ``h`` (the paper uses 1.5 dr with support 2h), particle spacing ``dr``, ``cfl`` of the
+    time step dt = cfl dr / sqrt(c0^2 + 4/3 cs^2) (eq. 26, cfl = 0.05), ``masses`` 'kernel'
+    (sec. 3.1) or 'lattice' (the masses of the arrays as given), ``theta_det``: relaxation
+    with the |det A|^(5/3) factor of the thesis' eq. 2.11 (the paper omits it).
+    """
+
+    def __init__(self, bodies, dim, rho0, c0, cs, h, dr, tau=math.inf, model="dprz", cp=0.0,
+                 walls=(), moving_walls=(), cfl=0.05, masses="kernel", theta_det=False,
+                 kernel="wendland"):
+        self.bodies, self.walls, self.moving_walls = list(bodies), list(walls), list(moving_walls)
+        if not self.bodies:
+            raise InputError("SHTCScheme: needs at least one body array")
+        if any(w not in self.walls for w in self.moving_walls):
+            raise InputError(f"SHTCScheme: moving_walls {self.moving_walls} must be among walls {self.walls}")
+        for name, v in (("rho0", rho0), ("c0", c0), ("h", h), ("dr", dr), ("cfl", cfl)):
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+                raise InputError(f"SHTCScheme: {name}={v!r} must be a positive finite number")
+        for name, v in (("cs", cs), ("cp", cp)):
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
+                raise InputError(f"SHTCScheme: {name}={v!r} must be a non-negative finite number")
+        if not (tau > 0):
+            raise InputError(f"SHTCScheme: tau={tau!r} must be > 0 (math.inf for an elastic solid)")
+        if model not in MODELS:
+            raise InputError(f"SHTCScheme: model must be one of {', '.join(MODELS)}, got {model!r}")
+        if masses not in ("kernel", "lattice"):
+            raise InputError(f"SHTCScheme: masses must be 'kernel' or 'lattice', got {masses!r}")
+        if cs == 0 and math.isfinite(tau):
+            raise InputError("SHTCScheme: relaxation (finite tau) needs a shear sound speed cs > 0")
+        self.dim = dim
+        self.rho0, self.c0, self.cs, self.h, self.dr = float(rho0), float(c0), float(cs), float(h), float(dr)
+        self.tau, self.model, self.cp, self.cfl = float(tau), model, float(cp), float(cfl)
+        self.masses, self.theta_det = masses, bool(theta_det)
+        self.kernel = get_kernel(kernel, dim)
+        self.speed_limit = self.wave_speed()
+        skip = {1: ("y", "z", "v", "w"), 2: ("z", "w"), 3: ()}[dim]
+        self.output_props = tuple(p for p in ("x", "y", "z", "u", "v", "w", "p", "rho", "m", "h", "A", "lam")
+                                  if p not in skip)
+        if self.cp == 0:
+            self.output_props = tuple(p for p in self.output_props if p != "lam")
+
+    # ---------------------------------------------------------------- parameters
+    def wave_speed(self):
+        """The longitudinal (P-wave) speed sqrt(c0^2 + 4/3 cs^2) of the linearised material."""
+        return math.sqrt(self.c0 ** 2 + 4.0 / 3.0 * self.cs ** 2)
+
+    @property
+    def relaxation_rate(self):
+        """3/tau (0 for an elastic solid)."""
+        return 0.0 if math.isinf(self.tau) else 3.0 / self.tau
+
+    def get_timestep(self):
+        """dt = cfl dr / sqrt(c0^2 + 4/3 cs^2) (Kincl et al. (2023), eq. 26 with cfl = 0.05)."""
+        return self.cfl * self.dr / self.wave_speed()
+
+    def stability_bounds(self, dt):
+        """The explicit RK4 relaxation: dt <= 2.785 tau/6 = 0.464 tau (stiffest rate 6/tau at A = I)."""
+        if math.isinf(self.tau):
+            return []
+        return [Bound("--dt", dt, RELAXATION_DT_LIMIT * self.tau, True,
+                      "dt <= 2.785 tau/6 = 0.464 tau: RK4 on the relaxation rate 6/tau of Kincl et al. "
+                      "(2023) eq. 24c")]
+
+    def density_bounds(self):
+        """(0.2, 5) rho0: summation density with C_rho stays near rho0 in every case of the paper."""
+        return {a: (0.2 * self.rho0, 5.0 * self.rho0) for a in self.bodies}
+
+    # ---------------------------------------------------------------- particles
+    def setup_properties(self, arrays):
+        for pa in arrays:
+            if pa.name not in self.bodies + self.walls:
+                continue
+            for p in ("p", "crho", "lam", "clam", "au", "av", "aw", "hflag"):
+                if not pa.has(p):
+                    pa.add_property(p)
+            for p in ("H", "L", "T"):
+                pa.add_property(p, stride=9)
+            if not pa.has("A") or "A" not in pa.data:
+                pa.add_property("A", stride=9, data=identity_tensors(pa.n))
+            if pa.name in self.walls:
+                # a wall at rest has v = 0 in L; a moving wall's motion sets its velocity
+                for c in ("u", "v", "w"):
+                    if c not in pa.data:
+                        pa.add_property(c, default=0.0)
+
+    # ---------------------------------------------------------------- equations
+    def get_equations(self):
+        every = self.bodies + self.walls
+        model = MODELS[self.model]
+        gradient = [RenormalisedVelocityGradient(d, every, dim=self.dim) for d in every]
+        state = []
+        for d in every:
+            state += [SummationDensityWithConstant(d, every),
+                      PenaltyLambda(d, every, cp=self.cp),
+                      KernelMoment(d, every),
+                      SHTCStress(d, dim=self.dim, model=model, rho0=self.rho0, c0=self.c0, cs=self.cs)]
+        force = []
+        for d in self.bodies:
+            force += [SHTCMomentum(d, every), TensilePenaltyForce(d, every, cp=self.cp, rho0=self.rho0)]
+        start = []
+        if self.masses == "kernel":
+            start.append(Group([KernelVolumeMass(d, every, rho0=self.rho0) for d in every]))
+        constants = [DensityConstant(d, every, rho0=self.rho0) for d in every]
+        constants += [PenaltyLambdaConstant(d, every, cp=self.cp) for d in every]
+        start.append(Group(constants))
+        return [[Group(gradient)], [Group(state), Group(force)], start]
+
+    def get_integrator(self):
+        model = MODELS[self.model]
+        detpow = THETA_DETPOW if self.theta_det else 0.0
+        steps = {b: SHTCStep(self.dim, model, self.relaxation_rate, detpow, move=True) for b in self.bodies}
+        steps.update({w: SHTCStep(self.dim, model, self.relaxation_rate, detpow, move=False)
+                      for w in self.walls})
+        return SHTCIntegrator(**steps)
+
+    def output_properties(self, pa):
+        props = super().output_properties(pa)
+        return props + [p for p in ("hflag",) if pa.has(p)]
+
+    # ---------------------------------------------------------------- diagnostics
+    def shear_energy_density(self, A):
+        """eps_s / cs^2 per particle from flat (n*9) A, numpy (eqs. 15, 17)."""
+        A = np.asarray(A).reshape(-1, 3, 3)
+        if self.model == "dprz":
+            G = np.einsum("nki,nkj->nij", A, A)
+            dev = G - np.trace(G, axis1=1, axis2=2)[:, None, None] / 3.0 * np.eye(3)
+            return 0.25 * np.einsum("nij,nij->n", dev, dev)
+        Ai = np.linalg.inv(A)
+        return 0.5 * (np.einsum("nij,nij->n", Ai, Ai) - 3.0 + 2.0 * np.log(np.linalg.det(A)))
+
+    def energies(self, arrays, include_walls=False):
+        """{kinetic, bulk, shear, penalty, total} over the bodies (and the walls if asked):
+        sum m v^2/2, sum m c0^2/2 (rho0/rho - 1)^2 (eq. 13), sum m eps_s (eqs. 15, 17),
+        1/2 sum m cp^2 (lambda/rho0)^2 (eq. 19)."""
+        names = self.bodies + (self.walls if include_walls else [])
+        e = {"kinetic": 0.0, "bulk": 0.0, "shear": 0.0, "penalty": 0.0}
+        for pa in arrays:
+            if pa.name not in names or pa.n == 0:
+                continue
+            m = pa.m
+            if "u" in pa.data:
+                e["kinetic"] += 0.5 * float(np.sum(m * sum(pa.data[c] ** 2 for c in "uvw"[:self.dim])))
+            e["bulk"] += float(np.sum(m * 0.5 * self.c0 ** 2 * (self.rho0 / pa.rho - 1.0) ** 2))
+            e["shear"] += float(np.sum(m * self.cs ** 2 * self.shear_energy_density(pa.A)))
+            if self.cp > 0 and "lam" in pa.data:
+                e["penalty"] += float(np.sum(0.5 * m * self.cp ** 2 * (pa.lam / self.rho0) ** 2))
+        e["total"] = e["kinetic"] + e["bulk"] + e["shear"] + e["penalty"]
+        return e
+
+    def singular_moments(self, arrays):
+        """Particles whose H was singular (regularised) in the last evaluation."""
+        return int(sum(np.count_nonzero(pa.hflag) for pa in arrays
+                       if pa.name in self.bodies + self.walls and "hflag" in pa.data))
