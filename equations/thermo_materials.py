@@ -76,9 +76,9 @@ def small_strain(F=[0.0], eps=[0.0]):
 @helper
 def energy_R(model=0, F=[0.0], H=[0.0], J=1.0, m=[0.0]):
     """E_R(F, H, J): internal energy per unit reference volume at theta_R (eqs. 26, 30; sec. 7.1)."""
+    eps = declare("matrix(9)")
     cg = m[5] * m[6]
     if model == 2:
-        eps = declare("matrix(9)")
         tr = small_strain(F, eps)
         return m[0] * ddot33(eps, eps) + 0.5 * m[2] * tr * tr + cg * m[7] * tr
     e = cg * m[7] * (J - 1.0)
@@ -301,3 +301,15 @@ class LinearThermoElastic(ThermoElasticMaterial):
 
 MATERIALS = {"mie_gruneisen": MieGruneisen, "entropic": ModifiedEntropicElasticity,
              "linear": LinearThermoElastic}
+
+
+@helper
+def energy_from_temperature(model=0, theta=0.0, kinetic=0.0, F=[0.0], H=[0.0], J=1.0, m=[0.0]):
+    """E = |p|^2/(2 rho_R) + E_R + c_v (theta - theta_R): the inverse of eq. 23."""
+    return kinetic + energy_R(model, F, H, J, m) + m[5] * (theta - m[7])
+
+
+@helper
+def entropy_from_temperature(model=0, theta=0.0, F=[0.0], H=[0.0], J=1.0, m=[0.0]):
+    """eta = eta_R + c_v ln(theta/theta_R): eq. 19, the inverse of eq. 20."""
+    return entropy_R(model, F, H, J, m) + m[5] * log(theta / m[7])
