@@ -37,6 +37,7 @@ FORMS = {"E": 0, "eta": 1}
 JUMPS = ("raw", "limited")
 
 STATE_9 = ("F", "H")
+FILLED = ("fb", "sb", "vB", "thB", "vfix", "tfix", "dEbc")    # set from Python (zero by default)
 VECTORS = ("gradT", "Q", "gs", "tint", "fb", "xc", "vB", "vfix")
 TENSORS = ("F", "H", "P", "L", "gw", "aF", "aH", "Fn", "Hn")
 SCALARS = ("J", "E", "eta", "theta", "p", "SJ", "cp", "cs", "dt_cfl", "aJ", "aE", "aeta", "sb",
@@ -259,10 +260,18 @@ class ThermoRK2(Integrator):
                         f"{name} {prop} = {a[i]:.4g} <= 0 at particle gid {int(pa.gid[i])} of "
                         f"'{pa.name}' {where} (t={t:.6g}): the state left the material's range")
 
+    def attach(self, scene):
+        """Complete the initial state as soon as the scene exists (so that what the
+        application samples at t = 0 is it): correction matrices, E or eta from the given
+        temperature, essential conditions at t = 0, theta, P and the wave speeds.  A restart
+        then overwrites it with the file's state."""
+        super().attach(scene)
+        self.compute_accelerations(3, 0.0, 0.0)
+        self.scene.stage("stage6", 0.0, 0.0)
+        self.impose(0.0)
+        self.state(2, 0.0, 0.0, "in the initial state")
+
     def initial_accelerations(self, t, dt):
-        self.compute_accelerations(3, t, dt)
-        self.scene.stage("stage6", t, dt)
-        self.impose(t)
         self.state(2, t, dt, "in the initial state")
 
     def _budget(self, name, dw, dq, de):
@@ -302,6 +311,7 @@ class ThermoUpwindScheme(Scheme):
     "0.6 x the largest spacing in the support" fixes no kernel; see docs/thermo.md);
     ``jumps``: 'raw' (the paper's eqs. 66, 72) or 'limited' (limited linear
     reconstruction); ``projection``: the angular-momentum projection of eqs. 79-82;
+    ``dt``: a fixed step instead of eq. 78 every step (it must respect eq. 78 at t = 0);
     ``dissipation`` False drops the upwinding (for tests).  Essential conditions: a body
     with a ``vfix`` property (3 flags per particle) gets its velocity components reset to
     ``vB`` (zero, or ``velocity(t, pa)``); one with ``tfix`` gets its temperature reset to
@@ -314,14 +324,14 @@ class ThermoUpwindScheme(Scheme):
     dim = 3
 
     def __init__(self, bodies, material, dx, hdx=1.2, kernel="wendland", form="E", reduced=False,
-                 jumps="raw", projection=False, dissipation=True, cfl=0.3):
+                 jumps="raw", projection=False, dissipation=True, cfl=0.3, dt=None):
         if not isinstance(material, ThermoElasticMaterial):
             raise InputError(f"ThermoUpwindScheme: material must be a ThermoElasticMaterial, got {material!r}")
         if form not in FORMS:
             raise InputError(f"ThermoUpwindScheme: form {form!r} must be one of {', '.join(FORMS)}")
         if jumps not in JUMPS:
             raise InputError(f"ThermoUpwindScheme: jumps {jumps!r} must be one of {', '.join(JUMPS)}")
-        for name, v in (("dx", dx), ("hdx", hdx), ("cfl", cfl)):
+        for name, v in (("dx", dx), ("hdx", hdx), ("cfl", cfl), ("dt", 1.0 if dt is None else dt)):
             if not (np.isfinite(v) and v > 0):
                 raise InputError(f"ThermoUpwindScheme: {name}={v!r} must be a positive number")
         if reduced and form != "E":
@@ -333,7 +343,8 @@ class ThermoUpwindScheme(Scheme):
         self.kernel = get_kernel(kernel, 3)
         self.form, self.reduced, self.jumps = form, bool(reduced), jumps
         self.projection, self.dissipation, self.cfl = bool(projection), bool(dissipation), float(cfl)
-        self.adaptive_dt = (("dt_cfl",), self.cfl)
+        self.dt = None if dt is None else float(dt)
+        self.adaptive_dt = (("dt_cfl",), self.cfl) if dt is None else None
         self.loads = []
         self.velocity, self.temperature = {}, {}
         self.arrays = {}
@@ -364,10 +375,10 @@ class ThermoUpwindScheme(Scheme):
                 raise InputError(f"ThermoUpwindScheme: body '{pa.name}' has a non-positive volume V")
             for p in SCALARS:
                 if not pa.has(p):
-                    pa.add_property(p)
+                    pa.add_property(p, default=0.0 if p in FILLED else None)
             for p in VECTORS:
                 if not pa.has(p):
-                    pa.add_property(p, stride=3)
+                    pa.add_property(p, stride=3, default=0.0 if p in FILLED else None)
             for p in TENSORS:
                 if not pa.has(p):
                     pa.add_property(p, stride=9)
@@ -436,12 +447,15 @@ class ThermoUpwindScheme(Scheme):
         return max(float(np.max(self.material.wave_speeds(pa.theta))) for pa in self.arrays.values())
 
     def get_timestep(self):
-        """alpha_CFL h_min / c_p,max (eq. 78) at the initial temperatures; the run
-        recomputes it every step from the particles' c_p."""
+        """The fixed ``dt`` if given, else alpha_CFL h_min / c_p,max (eq. 78) at the initial
+        temperatures (the run then recomputes it every step from the particles' c_p)."""
+        return self.dt if self.dt is not None else self.cfl_timestep()
+
+    def cfl_timestep(self):
         return self.cfl * self.dx / self.max_wave_speed()
 
     def stability_bounds(self, dt):
-        return [Bound("--dt", dt, self.get_timestep(), True,
+        return [Bound("--dt", dt, self.cfl_timestep(), True,
                       f"dt <= {self.cfl:g} h_min / c_p,max, Ghavamian et al. (2021) eq. 78")]
 
     def energies(self, arrays):
