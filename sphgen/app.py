@@ -196,12 +196,17 @@ class Application:
 
     def _solver(self, integrator, dt):
         opts = self.options
+        # a scheme with adaptive_dt = (dt_props, cfl) takes every step from the per-particle
+        # limits its equations write (at most dt), unless --dt fixes the step
+        adaptive = getattr(self.scheme, "adaptive_dt", None) if opts.dt is None else None
+        steps = dict(adaptive=True, dt_props=tuple(adaptive[0]), cfl=adaptive[1] * opts.dt_factor) \
+            if adaptive else {}
         solver = Solver(self.scene, integrator, dt, opts.tf, max_steps=opts.max_steps,
                         pfreq=opts.pfreq, outdir=self.outdir, prefix=self.name,
                         disable_output=opts.disable_output, progress=opts.progress,
                         speed_limit=self.scheme.speed_limit,
                         density_bounds=self.scheme.density_bounds(),
-                        metadata={"signature": self.signature, "tf": opts.tf})
+                        metadata={"signature": self.signature, "tf": opts.tf}, **steps)
         solver.post_step_callbacks.append(self.post_step)
         solver.output_callbacks.append(lambda s, path: self._write_progress())
         if self.diagnostics:

@@ -41,6 +41,9 @@ class Scheme:
 
     output_props = ("x", "y", "u", "v", "p", "rho", "m", "h")
     speed_limit = None
+    # (dt_props, cfl): the application steps adaptively, cfl * min over the particles of
+    # the properties dt_props (written by the scheme's equations), capped at get_timestep()
+    adaptive_dt = None
 
     def density_bounds(self):
         """{array name: (lowest, highest) density} the guard enforces (none by default)."""

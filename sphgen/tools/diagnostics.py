@@ -53,6 +53,14 @@ def pressure_range(arrays, dim):
     return [float(min(a.min() for a in p)), float(max(a.max() for a in p))] if p else [0.0, 0.0]
 
 
+def _range(prop):
+    def smallest_and_largest(arrays, dim):
+        vals = [pa.data[prop] for pa in arrays if prop in pa.data and pa.n]
+        return [float(min(a.min() for a in vals)), float(max(a.max() for a in vals))] if vals else [0.0, 0.0]
+    smallest_and_largest.__doc__ = f"Smallest and largest {prop} over arrays that have one."
+    return smallest_and_largest
+
+
 DIAGNOSTICS = {
     "mass": (mass, lambda dim: ["mass"]),
     "kinetic_energy": (kinetic_energy, lambda dim: ["kinetic_energy"]),
@@ -62,6 +70,9 @@ DIAGNOSTICS = {
                          [f"angular_momentum_{c}" for c in "xyz"]),
     "density_range": (density_range, lambda dim: ["rho_min", "rho_max"]),
     "pressure_range": (pressure_range, lambda dim: ["p_min", "p_max"]),
+    # Total Lagrangian solids: volume ratio J (must stay > 0) and temperature
+    "J_range": (_range("J"), lambda dim: ["J_min", "J_max"]),
+    "theta_range": (_range("theta"), lambda dim: ["theta_min", "theta_max"]),
 }
 
 
