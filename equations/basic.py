@@ -21,3 +21,13 @@ class Vorticity2D(Equation):
     def loop(self, d_idx, d_omega, s_idx, s_m, s_rho, VIJ, DWIJ):
         vb = s_m[s_idx] / s_rho[s_idx]
         d_omega[d_idx] += -vb * (VIJ[0] * DWIJ[1] - VIJ[1] * DWIJ[0])
+
+
+class SummationDensityWithConstant(Equation):
+    """rho_a = C_a + sum_b m_b W_ab with a time-independent C_a (``crho``) fixed at t = 0 (Kincl 2023, eq. 1.14)."""
+
+    def initialize(self, d_idx, d_rho, d_crho):
+        d_rho[d_idx] = d_crho[d_idx]
+
+    def loop(self, d_idx, d_rho, s_idx, s_m, WIJ):
+        d_rho[d_idx] += s_m[s_idx] * WIJ
