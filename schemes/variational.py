@@ -38,7 +38,8 @@ except ImportError:  # pragma: no cover
     Bound = None
 
 from ..equations.variational import (GaussianContinuityDensity, GaussianPressureGradient,
-                                     PaperArtificialViscosity, ZeroAcceleration, kernel_parameters)
+                                     GaussianSummationDensity, PaperArtificialViscosity,
+                                     ZeroAcceleration, kernel_parameters)
 from ..equations.walls import LennardJonesWallForce
 from ..equations.wcsph import TaitEOS
 
@@ -281,6 +282,10 @@ class VariationalScheme(Scheme):
     (eq. 67), artificial viscosity (eq. 55), Lennard-Jones wall force (eq. 58), gravity;
     ``integrator`` 'variational' (alpha, tol, max_iter) or 'explicit' (eqs. 59-62).
 
+    ``density='summation'`` replaces the continuity density by the summation density at the
+    interpolated configuration (eq. 20): with ``av_a = av_b = 0`` and no walls this is the
+    "pure" variational scheme of eq. 37, and alpha in {0, 1} is Stormer-Verlet (eq. 38).
+
     Fluids need ``h = rc/3`` (the quintic spline's support 3h is the neighbour radius);
     boundary arrays (``walls``) only need positions and that ``h``.
     """
@@ -290,7 +295,7 @@ class VariationalScheme(Scheme):
     def __init__(self, fluids, walls, dim=2, rho0=1000.0, c0=23.841, gx=0.0, gy=0.0,
                  kernel="K3", dx=0.005, h_cut=0.072, av_a=1.0, av_b=1.0, D=5.684, r0=0.005,
                  wall_power=1, integrator="variational", alpha=0.5, tol=1e-3, max_iter=50,
-                 gamma=7.0, predictor="verlet", dt=None):
+                 gamma=7.0, predictor="verlet", dt=None, density="continuity"):
         if dim != 2:
             raise ValueError("VariationalScheme: only dim = 2 is implemented")
         if integrator not in ("variational", "explicit"):
@@ -306,6 +311,9 @@ class VariationalScheme(Scheme):
         self.hphi = h_cut if kernel in ("K1", "K2") else self.lam   # digest A34
         self.av_a, self.av_b, self.D, self.r0, self.wall_power = av_a, av_b, D, r0, wall_power
         self.integrator, self.alpha, self.tol, self.max_iter = integrator, alpha, tol, max_iter
+        if density not in ("continuity", "summation"):
+            raise ValueError(f"VariationalScheme: density {density!r}: continuity or summation")
+        self.density = density
         if predictor not in PREDICTORS:
             raise ValueError(f"VariationalScheme: predictor {predictor!r}: {', '.join(PREDICTORS)}")
         self.predictor, self.dt = predictor, dt
@@ -331,11 +339,19 @@ class VariationalScheme(Scheme):
 
     def get_equations(self):
         f, w = self.fluids, self.walls
-        eos = [TaitEOS(d, None, rho0=self.rho0, c0=self.c0, gamma=self.gamma) for d in f]
-        old = [Group(eos), Group([e for d in f for e in self._forces(d)])]
-        new = [Group([GaussianContinuityDensity(d, f, **self._kw()) for d in f]),
-               Group([TaitEOS(d, None, rho0=self.rho0, c0=self.c0, gamma=self.gamma) for d in f]),
-               Group([e for d in f for e in self._forces(d)])]
+        summation = self.density == "summation"
+
+        def eos():
+            return Group([TaitEOS(d, None, rho0=self.rho0, c0=self.c0, gamma=self.gamma) for d in f])
+
+        def density():
+            cls = GaussianSummationDensity if summation else GaussianContinuityDensity
+            return Group([cls(d, f, **self._kw()) for d in f])
+
+        # set 0 at xbar(q_{k-1}, q_k): the continuity density rho_{k-1,k} is the stored one,
+        # the summation density is recomputed there (eq. 20)
+        old = ([density()] if summation else []) + [eos(), Group([e for d in f for e in self._forces(d)])]
+        new = [density(), eos(), Group([e for d in f for e in self._forces(d)])]
         walls = [ZeroAcceleration(d) for d in f]
         if w:
             walls += [LennardJonesWallForce(d, w, D=self.D, r0=self.r0, power=self.wall_power) for d in f]
