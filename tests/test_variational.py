@@ -211,3 +211,65 @@ def test_alpha_zero_with_continuity_density_is_a_velocity_implicit_leapfrog():
     cont_o, f, dx, dy, vx, r = _reference_rates(xk, yk, uo, vo, None, m, s, nx * DX)
     ax_o, _ = _reference_acceleration(f, dx, dy, vx, r, rho_old + dt * cont_o, m, s)
     assert np.abs(uo + dt * ax_o - un).max() > 1e3 * np.abs(uo + dt * ax - un).max()
+
+
+def test_contraction_monitor_stops_a_diverging_iteration():
+    """dt = 4e-4 on the test cloud: the fixed-point map is no contraction (ratios > 1); the
+    run stops at once, naming step and residual, with the arrays back at the step's start."""
+    pa, integ, _ = build("variational", alpha=0.5, tol=1e-13, max_iter=50)
+    integ.one_timestep(0.0, 4e-4)
+    x1, u1, rho1 = pa.x.copy(), pa.u.copy(), pa.rho.copy()
+    with pytest.raises(BlowUpError, match=r"diverges at step 2 \(t=0.0004 -> 0.0008\): residual \S+ m "
+                                          r".*did not fall over 3 iterations"):
+        integ.one_timestep(4e-4, 4e-4)
+    assert len(integ.history) == 1
+    assert np.array_equal(pa.x, x1) and np.array_equal(pa.u, u1) and np.array_equal(pa.rho, rho1)
+
+
+DAM = ["--threads", "1", "--no-progress", "--tol", "1e-12"]
+
+
+def dam(args):
+    from sphgen.app import load_application
+    app = load_application("dam_break_variational")()
+    app.run(DAM + args)
+    return app
+
+
+@pytest.mark.parametrize("integrator", ["variational", "explicit"])
+def test_restart_is_bit_for_bit(tmp_path, integrator):
+    """A run restarted from its output of step 10 ends with the same files, bit for bit,
+    and the same time series (the start-up step is not taken again)."""
+    import json
+    from sphgen import io
+    run = ["--integrator", integrator, "--tf", "0.002", "--pfreq", "10", "--record-every", "3e-4"]
+    dam(run + ["-d", str(tmp_path / "full")])
+    mid = io.output_files(tmp_path / "full")[1]
+    assert io.step_of(mid) == 10
+    dam(run + ["-d", str(tmp_path / "part"), "--restart", mid])
+    a = io.load(io.output_files(tmp_path / "full")[-1])["arrays"]["fluid"]
+    b = io.load(io.output_files(tmp_path / "part")[-1])["arrays"]["fluid"]
+    assert np.abs(a.y - io.load(mid)["arrays"]["fluid"].y).max() > 1e-6
+    for p in a.data:
+        assert np.array_equal(a.data[p], b.data[p]), p
+    for name in ("history.json", "steps.json"):
+        ra = json.load(open(tmp_path / "full" / name))["rows"]
+        rb = json.load(open(tmp_path / "part" / name))["rows"]
+        assert json.dumps(ra) == json.dumps(rb), name
+    steps = json.load(open(tmp_path / "full" / "steps.json"))["rows"]
+    assert len(steps) == 20 and (integrator == "explicit" or min(r[2] for r in steps[1:]) >= 1)
+
+
+def test_non_converged_step_stops_the_application_with_one_line(tmp_path, capsys):
+    """--max-iter 1 with a tight tol: one 'sphgen:' line naming step and residual, the last
+    good state (the step before) on disk."""
+    from sphgen import io
+    out = tmp_path / "nc"
+    with pytest.raises(SystemExit):
+        dam(["--max-iter", "1", "--tf", "0.001", "-d", str(out)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("sphgen: variational fixed-point iteration did not converge "
+                                               "at step 3 (t=0.0002 -> 0.0003): residual ")
+    assert "last good state (step 2" in err[0]
+    good = io.load(str(out / "dam_break_variational_last_good.h5"))
+    assert good["solver_data"]["step"] == 2
