@@ -32,10 +32,10 @@ from math import sqrt
 
 import numpy as np
 
-from sphgen import io
+from sphgen import io, run_folder
 from sphgen.app import Application
 from sphgen.particles import ParticleArray
-from sphgen.tools.probes import front_position
+from sphgen.tools.probes import count_neighbours, front_position
 from sphgen.tools import reference
 
 from ..schemes.variational import PREDICTORS, VariationalScheme
@@ -52,6 +52,9 @@ DX = 0.005
 L = NX * DX        # column width 0.145
 H = NY * DX        # column height 0.29
 RHO0, G, MASS = 1000.0, 9.8, 0.025
+STEP_COLUMNS = ("t", "step", "iterations", "residual", "contraction", "budget")
+"""steps.json, one row per step: fixed-point iterations (0: explicit or the start-up step),
+last residual r_j (m), largest ratio r_j/r_{j-1}, momentum-budget residual (m/s)."""
 
 
 class DamBreakVariational(Application):
@@ -59,6 +62,7 @@ class DamBreakVariational(Application):
 
     tf = 1.0
     pfreq = 1000
+    error_key = "position_error_rms"   # `sphgen precision ... --reference-run DIR`
     dim = 2
     history_columns = ("t", "T", "toe", "Q", "px", "py", "iterations_max", "residual_max",
                        "contraction_max", "budget_max", "rho_min", "rho_max", "kinetic", "potential", "internal")
@@ -88,7 +92,16 @@ class DamBreakVariational(Application):
         group.add_argument("--open-top", action="store_true", help="no lid; side walls to 2 x 0.29 m")
         group.add_argument("--time-step", type=float, default=1e-4, help="dt (default the paper's 1e-4 s)")
         group.add_argument("--record-every", type=float, default=1e-3,
-                           help="time between history samples (default %(default)s s)")
+                           help="time between history samples (default %(default)s s); the "
+                                "per-step rows (iterations, residual, budget) go to steps.json")
+        group.add_argument("--density", choices=("continuity", "summation"), default="continuity",
+                           help="continuity (eq. 67, the paper's runs) or summation density (eq. 20)")
+        group.add_argument("--perturb", type=float, default=0.0,
+                           help="random displacement of the fluid particles, in dx (default 0)")
+        group.add_argument("--seed", type=int, default=1, help="seed of --perturb (default 1)")
+        group.add_argument("--reference-run", default=None, metavar="DIR",
+                           help="a run of this case (e.g. at a fine dt) to measure the position "
+                                "error against at the final time (results.json position_error_*)")
 
     def consume_user_options(self, o):
         for name in ("tol", "h_cut", "c0", "D", "r0", "wall_spacing", "time_step", "record_every"):
@@ -99,19 +112,24 @@ class DamBreakVariational(Application):
             raise InputError(f"--alpha must be in [0, 1], got {o.alpha}")
         if o.max_iter < 1:
             raise InputError(f"--max-iter must be >= 1, got {o.max_iter}")
+        if not (np.isfinite(o.perturb) and 0.0 <= o.perturb < 0.5):
+            raise InputError(f"--perturb must be in [0, 0.5), got {o.perturb}")
+        if o.reference_run is not None and not (os.path.isdir(o.reference_run)
+                                                and io.output_files(o.reference_run)):
+            raise InputError(f"--reference-run {o.reference_run}: no output files there")
         self.history = []
+        self.steps = []            # one row per step: STEP_COLUMNS
         self._next_record = 0.0
         self._p_prev = None
-        self._budget = 0.0
-        self._window = []
-        self.all_iterations = []
+        self._window_start = 0     # first row of self.steps since the last history sample
 
     def create_scheme(self):
         o = self.options
         return VariationalScheme(["fluid"], ["wall"], dim=2, rho0=RHO0, c0=o.c0, gy=-G, kernel=o.kernel,
                                  dx=DX, h_cut=o.h_cut, av_a=o.av_a, av_b=o.av_b, D=o.D, r0=o.r0,
                                  wall_power=o.wall_power, integrator=o.integrator, alpha=o.alpha,
-                                 tol=o.tol, max_iter=o.max_iter, predictor=o.predictor, dt=o.time_step)
+                                 tol=o.tol, max_iter=o.max_iter, predictor=o.predictor, dt=o.time_step,
+                                 density=o.density)
 
     def create_particles(self):
         o = self.options
@@ -119,6 +137,10 @@ class DamBreakVariational(Application):
         ax, ay = (np.arange(NX) + 0.5) * DX, (np.arange(NY) + 0.5) * DX
         x, y = (g.ravel() for g in np.meshgrid(ax, ay, indexing="ij"))
         n = x.size
+        if o.perturb > 0:
+            rng = np.random.default_rng(o.seed)
+            x = x + o.perturb * DX * rng.uniform(-1, 1, n)
+            y = y + o.perturb * DX * rng.uniform(-1, 1, n)
         fluid = ParticleArray("fluid", x=x, y=y, u=np.zeros(n), v=np.zeros(n), m=np.full(n, MASS),
                               rho=np.full(n, RHO0), h=np.full(n, h))
         fluid.add_property("p")
@@ -136,49 +158,74 @@ class DamBreakVariational(Application):
         xw, yw = np.concatenate(xs), np.concatenate(ys)
         wall = ParticleArray("wall", x=xw, y=yw, m=np.full(xw.size, MASS), h=np.full(xw.size, h))
         self.M = float(fluid.m.sum())
+        self.E0 = float(np.sum(fluid.m * G * fluid.y))   # at rest, rho = rho0: gravity only
         return [fluid, wall]
 
     def history_meta(self):
         o = self.options
-        it = np.array(self.all_iterations, dtype=float).reshape(-1, 3) if self.all_iterations else None
-        meta = {"integrator": o.integrator, "alpha": o.alpha, "tol": o.tol, "kernel": o.kernel,
-                "L": L, "M": self.M}
-        if it is not None and it.size:
-            meta.update({"steps_iterated": int(it.shape[0]), "iterations_mean": float(it[:, 0].mean()),
-                         "iterations_max": int(it[:, 0].max()), "residual_max": float(it[:, 1].max()),
-                         "contraction_max": float(np.nanmax(it[:, 2])) if np.isfinite(it[:, 2]).any()
-                         else None})
-        return meta
+        return {"integrator": o.integrator, "alpha": o.alpha, "tol": o.tol, "kernel": o.kernel,
+                "density": o.density, "L": L, "M": self.M, "E0": self.E0}
+
+    def _write_progress(self, completed=False, error=None):
+        """history.json and info.json (base class) and steps.json: one row per step."""
+        super()._write_progress(completed, error)
+        io.write_json(os.path.join(self.outdir, "steps.json"),
+                      {"columns": list(STEP_COLUMNS), "rows": self.steps,
+                       "evaluations": getattr(self.solver.integrator, "evaluations", None)})
+
+    def _signature(self, arrays):
+        """The scene's identity for restarts: --reference-run only changes the analysis."""
+        sig = super()._signature(arrays)
+        sig["options"].pop("reference_run", None)
+        return sig
+
+    def _restart(self, path, data, dt):
+        """Continue the time series exactly: the per-step rows, the last half-step momentum
+        (Q is the mean of two), the next sample time and the steps since the last sample."""
+        super()._restart(path, data, dt)
+        t = self.solver.t
+        steps = run_folder.earlier_history(path, t, "steps.json")
+        self.steps = [list(r) for r in steps["rows"]] if steps is not None else []
+        f = self.scene.by_name["fluid"]
+        self._p_prev = np.array([np.sum(f.m * f.u), np.sum(f.m * f.v)])
+        if self.history:
+            last = self.history[-1][0]
+            self._next_record = last + self.options.record_every
+            self._window_start = sum(1 for r in self.steps if r[0] <= last + 1e-12 * max(1.0, last))
+        else:
+            self._window_start = len(self.steps)
 
     # ------------------------------------------------------------ diagnostics
     def post_step(self, solver):
         f = self.scene.by_name["fluid"]
         integ = solver.integrator
+        it, res, con = 0, float("nan"), float("nan")    # explicit, or the start-up step
         if hasattr(integ, "iterations") and integ.k > 1:
-            row = (integ.iterations, integ.residual, integ.contraction)
-            self.all_iterations.append(row)
-            self._window.append(row)
+            it, res, con = integ.iterations, integ.residual, integ.contraction
         p = np.array([np.sum(f.m * f.u), np.sum(f.m * f.v)])   # sum m v_{k+1/2} after the step
+        budget = float("nan")
         if self._p_prev is not None:
-            # momentum budget (digest 1.10): sum m dv = dt sum m (Gamma_k + g), to round-off
+            # momentum budget: sum m dv = dt sum m (Gamma_k + g), to round-off
             imp = solver.last_dt * np.array([np.sum(f.m * f.gwx), np.sum(f.m * (f.gwy - G))])
-            self._budget = max(self._budget, float(np.abs(p - self._p_prev - imp).max()) / self.M)
+            budget = float(np.abs(p - self._p_prev - imp).max()) / self.M
+        self.steps.append([solver.t, solver.step, it, res, con, budget])
         p_mid = p if self._p_prev is None else 0.5 * (p + self._p_prev)
         self._p_prev = p
         if solver.t + 1e-12 >= self._next_record or solver.t >= solver.tf - 1e-12:
-            w = np.array(self._window, dtype=float).reshape(-1, 3)
-            self._window = []
+            w = np.array(self.steps[self._window_start:], dtype=float)
+            self._window_start = len(self.steps)
+            iterated = w[:, 2] >= 1
             e = self.scheme.energies([f])
             toe = front_position(f.x, f.y, 0.0, DX) / L
             self.history.append([
                 solver.t, solver.t * sqrt(2.0 * G / L), toe, float(np.hypot(*p_mid)) / self.M,
                 float(p_mid[0]), float(p_mid[1]),
-                float(w[:, 0].max()) if w.size else 0.0, float(w[:, 1].max()) if w.size else 0.0,
-                float(np.nanmax(w[:, 2])) if w.size and np.isfinite(w[:, 2]).any() else float("nan"),
-                self._budget,
+                float(w[iterated, 2].max()) if iterated.any() else 0.0,
+                float(w[iterated, 3].max()) if iterated.any() else 0.0,
+                float(np.nanmax(w[:, 4])) if np.isfinite(w[:, 4]).any() else float("nan"),
+                float(np.nanmax(w[:, 5])) if np.isfinite(w[:, 5]).any() else 0.0,
                 float(f.rho.min()), float(f.rho.max()), e["kinetic"], e["potential"], e["internal"]])
             self._next_record = solver.t + self.options.record_every
-            self._budget = 0.0
 
     # ------------------------------------------------------------ results
     def post_process(self, outdir):
@@ -190,14 +237,21 @@ class DamBreakVariational(Application):
         cols = {c: rows[:, i] for i, c in enumerate(hist["columns"])}
         T, Z = cols["T"], cols["toe"]
         ok = np.isfinite(Z)
-        results = {k: hist.get(k) for k in ("integrator", "alpha", "tol", "kernel", "steps_iterated",
-                                              "iterations_mean", "iterations_max", "residual_max",
-                                              "contraction_max")}
+        results = {k: hist.get(k) for k in ("integrator", "alpha", "tol", "kernel", "density")}
+        results.update(iteration_statistics(outdir))
+        energy = cols["kinetic"] + cols["potential"] + cols["internal"]
         results.update({"t": float(cols["t"][-1]), "T": float(T[-1]), "n_samples": int(rows.shape[0]),
                         "Q_max": float(cols["Q"].max()), "t_Q_max": float(cols["t"][np.argmax(cols["Q"])]),
                         "Q_final": float(cols["Q"][-1]),
                         "momentum_budget_residual_max": float(cols["budget_max"].max()),
-                        "rho_min": float(cols["rho_min"].min()), "rho_max": float(cols["rho_max"].max())})
+                        "rho_min": float(cols["rho_min"].min()), "rho_max": float(cols["rho_max"].max()),
+                        "max_density_error": float(max(abs(cols["rho_min"].min() / RHO0 - 1.0),
+                                                       abs(cols["rho_max"].max() / RHO0 - 1.0))),
+                        "energy_final": float(energy[-1]) / hist["E0"] - 1.0,
+                        "energy_error": float(np.abs(energy / hist["E0"] - 1.0).max()),
+                        "ejected_final": int(ejected(*final_positions(outdir)).sum())})
+        if self.options.reference_run:
+            results.update(position_error(outdir, self.options.reference_run))
         refs = {"martin_moyce_a2.25in": reference.martin_moyce_1952(2.25),
                 "martin_moyce_a1.125in": reference.martin_moyce_1952(1.125),
                 "koshizuka_oka": reference.koshizuka_oka_1996()}
@@ -235,12 +289,106 @@ class DamBreakVariational(Application):
         fig.tight_layout()
         fig.savefig(os.path.join(outdir, "momentum.png"), dpi=100)
         plt.close(fig)
-        fig, (a1, a2) = plt.subplots(2, 1, figsize=(6, 6), sharex=True)
-        a1.plot(cols["t"], cols["iterations_max"], "k.")
-        a1.set_ylabel("iterations (max per sample)")
-        a2.semilogy(cols["t"], np.maximum(cols["residual_max"], 1e-300), "k.")
-        a2.set_ylabel("residual (m)")
-        a2.set_xlabel("t (s)")
+        it = _iterations(outdir)
+        if it.size == 0:
+            return
+        fig, (a1, a2, a3) = plt.subplots(3, 1, figsize=(6, 7), sharex=True)
+        a1.plot(it[:, 0], it[:, 2], "k.", ms=2)
+        a1.set_ylabel("iterations")
+        a2.semilogy(it[:, 0], np.maximum(it[:, 3], 1e-300), "k.", ms=2)
+        a2.set_ylabel("last residual (m)")
+        a3.plot(it[:, 0], it[:, 4], "k.", ms=2)
+        a3.set_ylabel("contraction (max ratio)")
+        a3.set_xlabel("t (s)")
         fig.tight_layout()
         fig.savefig(os.path.join(outdir, "iterations.png"), dpi=100)
         plt.close(fig)
+
+
+# ---------------------------------------------------------------- analysis of finished runs
+def _steps(outdir):
+    """(rows of steps.json as an array (STEP_COLUMNS), evaluations) of a run."""
+    with open(os.path.join(outdir, "steps.json")) as fh:
+        data = json.load(fh)
+    return np.array(data["rows"], dtype=float).reshape(-1, len(STEP_COLUMNS)), data.get("evaluations")
+
+
+def _iterations(outdir):
+    """The per-step rows of the steps that iterated (t, step, iterations, residual, contraction)."""
+    rows, _ = _steps(outdir)
+    return rows[rows[:, 2] >= 1, :5]
+
+
+def iteration_statistics(outdir):
+    """Per-step fixed-point statistics of a run (None for the explicit integrator), and the
+    number of equation-set evaluations of the time loop (since the last restart)."""
+    it = _iterations(outdir)
+    evaluations = _steps(outdir)[1]
+    if it.size == 0:
+        return {"steps_iterated": 0, "iterations_mean": None, "iterations_max": None,
+                "iteration_counts": None, "residual_max": None, "contraction_max": None,
+                "evaluations": evaluations}
+    n, counts = np.unique(it[:, 2].astype(int), return_counts=True)
+    c = it[:, 4][np.isfinite(it[:, 4])]
+    return {"steps_iterated": int(it.shape[0]), "iterations_mean": float(it[:, 2].mean()),
+            "iterations_max": int(it[:, 2].max()),
+            "iteration_counts": {str(k): int(v) for k, v in zip(n, counts)},
+            "residual_max": float(it[:, 3].max()), "contraction_max": float(c.max()) if c.size else None,
+            "evaluations": evaluations}
+
+
+def positions(path):
+    """(gid, x, y) of the fluid in an output file, sorted by persistent id."""
+    f = io.load(path)["arrays"]["fluid"]
+    order = np.argsort(f.gid)
+    return f.gid[order], f.x[order], f.y[order]
+
+
+def final_positions(outdir):
+    """(x, y) of the fluid in the last output file of a run."""
+    _, x, y = positions(io.output_files(outdir)[-1])
+    return x, y
+
+
+def ejected(x, y):
+    """Fluid particles out of the fluid volume: fewer than a quarter of the median number of
+    neighbours within 2.5 dx (the rule of :func:`sphgen.tools.probes.front_position`)."""
+    counts = count_neighbours((np.asarray(x), np.asarray(y)), 2.5 * DX)
+    return counts < 0.25 * np.median(counts)
+
+
+def outputs_by_time(outdir):
+    """{t: path} of a run's output files."""
+    return {round(float(io.read_solver_data(p)["t"]), 9): p for p in io.output_files(outdir)}
+
+
+def scheme_difference(dir_a, dir_b):
+    """D(t) = max_i |q_i^a - q_i^b| (da Silva & Giraldi 2024, eq. 70), particles paired by
+    their persistent id, at the output times the two runs share: (t, D) arrays."""
+    a, b = outputs_by_time(dir_a), outputs_by_time(dir_b)
+    ts = sorted(set(a) & set(b))
+    d = []
+    for t in ts:
+        ga, xa, ya = positions(a[t])
+        gb, xb, yb = positions(b[t])
+        if not np.array_equal(ga, gb):
+            raise InputError(f"{a[t]} and {b[t]} do not hold the same particles")
+        d.append(float(np.hypot(xa - xb, ya - yb).max()))
+    return np.array(ts), np.array(d)
+
+
+def position_error(outdir, reference_dir):
+    """Position error of a run's last output against the output of ``reference_dir`` at the
+    same time: max and rms over the fluid of |q_i - q_i^ref| (metres)."""
+    last = io.output_files(outdir)[-1]
+    t = round(float(io.read_solver_data(last)["t"]), 9)
+    ref = outputs_by_time(reference_dir).get(t)
+    if ref is None:
+        raise InputError(f"--reference-run {reference_dir} has no output at t={t:g}")
+    g, x, y = positions(last)
+    gr, xr, yr = positions(ref)
+    if not np.array_equal(g, gr):
+        raise InputError(f"--reference-run {reference_dir} holds other particles")
+    e = np.hypot(x - xr, y - yr)
+    return {"position_error_max": float(e.max()), "position_error_rms": float(np.sqrt(np.mean(e * e))),
+            "reference_run": os.path.abspath(reference_dir)}

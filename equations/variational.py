@@ -19,7 +19,8 @@ What the paper needs beyond :mod:`equations.wcsph` (Tait, reused) and
   fixed-point map has no jump at r = rc (digest A20h/A41), and
   ell = 1/(pi lam^2 I), I = 1 - e^{-k^2}(1 + k^2 + k^4/2), k = rc/lam: the 2-D integral
   of the W whose gradient this is.  See :func:`kernel_parameters`.
-* the continuity density of eq. 67 with its sign fixed (digest A11),
+* the continuity density of eq. 67 with its sign fixed (digest A11), and the summation
+  density of eq. 20 at the interpolated configuration (the "pure" variational scheme),
 * the symmetric pressure gradient of eqs. 37/64 with that gradient,
 * the artificial viscosity of eq. 55 with the dissipative (Monaghan) sign (digest A4).
 
@@ -56,6 +57,30 @@ def gauss_grad_factor(r=0.0, ell=1.0, lam=1.0, rc=1.0, shift=0.0):
         return 0.0
     q = r / lam
     return -2.0 * ell / (lam * lam) * (exp(-q * q) - shift)
+
+
+@helper
+def gauss_w(r=0.0, ell=1.0, lam=1.0, rc=1.0, shift=0.0):
+    """W(r) whose gradient is :func:`gauss_grad_factor` times x_ij:
+    ell (exp(-(r/lam)^2) - shift (1 + (rc^2 - r^2)/lam^2)), 0 beyond rc (da Silva & Giraldi
+    2024, eqs. 10 and 69; shift = 0 is the printed plain cut)."""
+    if r > rc:
+        return 0.0
+    q = r / lam
+    return ell * (exp(-q * q) - shift * (1.0 + (rc * rc - r * r) / (lam * lam)))
+
+
+class GaussianSummationDensity(Equation):
+    """rho_i = sum_j m_j W(beta_ij) at the current (interpolated) configuration (da Silva &
+    Giraldi 2024, eqs. 8 and 20); writes ``rho``.  Sources: the fluids (self included)."""
+
+    positive = ("lam", "rc")
+
+    def initialize(self, d_idx, d_rho):
+        d_rho[d_idx] = 0.0
+
+    def loop(self, d_idx, d_rho, s_idx, s_m, RIJ):
+        d_rho[d_idx] += s_m[s_idx] * gauss_w(RIJ, self.ell, self.lam, self.rc, self.shift)
 
 
 class GaussianContinuityDensity(Equation):

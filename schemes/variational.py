@@ -38,7 +38,8 @@ except ImportError:  # pragma: no cover
     Bound = None
 
 from ..equations.variational import (GaussianContinuityDensity, GaussianPressureGradient,
-                                     PaperArtificialViscosity, ZeroAcceleration, kernel_parameters)
+                                     GaussianSummationDensity, PaperArtificialViscosity,
+                                     ZeroAcceleration, kernel_parameters)
 from ..equations.walls import LennardJonesWallForce
 from ..equations.wcsph import TaitEOS
 
@@ -186,10 +187,23 @@ class ExplicitLeapfrog(Integrator):
     def __init__(self, **steppers):
         super().__init__(**steppers)
         self.k = 0
+        self.evaluations = 0     # equation-set evaluations (each with its neighbour search)
 
     def evaluate(self, index, t, dt):
         self.update_nnps()
         self.compute_accelerations(index, t, dt)
+        self.evaluations += 1
+
+    def restarted(self, step, t):
+        """Continue a run from its output of step ``step``: no second start-up step.  The
+        file holds x = q_k, u = v_{k-1/2}, rho = rho_{k-1,k}; the levels the next step reads
+        (uh, vh, rhok) are set from them (they are equal in a file this integrator wrote)."""
+        self.k = int(step)
+        for name in self.steppers:
+            pa = self.scene.by_name[name]
+            for level, value in (("uh", "u"), ("vh", "v"), ("rhok", "rho")):
+                if level in pa.data and value in pa.data:
+                    np.copyto(pa.data[level], pa.data[value])
 
     def explicit_step(self, t, dt):
         if self.k == 0:
@@ -212,19 +226,25 @@ class VariationalMidpoint(ExplicitLeapfrog):
 
     ``tol`` (eps, metres, on max_i |q^(j) - q^(j-1)|), ``max_iter`` (the cap: a step not
     converged puts the arrays back to the start of the step and raises BlowUpError naming
-    the step, 1-based as the solver counts, and the residual).  Per step it records
-    ``iterations``, ``residual`` (last r_j), ``residuals`` (all r_j) and ``contraction``
-    (max r_j/r_{j-1}, nan for one iteration); ``history`` keeps (step, iterations, residual,
-    contraction) of every step.
+    the step, 1-based as the solver counts, and the residual).  The contraction is
+    monitored while iterating: a residual that has not fallen over ``diverge_after``
+    iterations (r_j >= r_{j-n}: the map is no contraction at this dt, the bound of eq. 54 is
+    violated) stops the run the same way at once.
+    Per step it records ``iterations``, ``residual`` (last r_j), ``residuals`` (all r_j) and
+    ``contraction`` (max r_j/r_{j-1}, nan for one iteration); ``history`` keeps (step,
+    iterations, residual, contraction) of every step.
     """
 
-    def __init__(self, alpha=0.5, tol=1e-3, max_iter=50, **steppers):
+    def __init__(self, alpha=0.5, tol=1e-3, max_iter=50, diverge_after=3, **steppers):
         super().__init__(**steppers)
         if not 0.0 <= alpha <= 1.0:
             raise ValueError(f"VariationalMidpoint: alpha={alpha!r} must be in [0, 1]")
         if not tol > 0 or int(max_iter) < 1:
             raise ValueError(f"VariationalMidpoint: tol={tol!r} must be > 0, max_iter={max_iter!r} >= 1")
+        if int(diverge_after) < 1:
+            raise ValueError(f"VariationalMidpoint: diverge_after={diverge_after!r} must be >= 1")
         self.alpha, self.tol, self.max_iter = float(alpha), float(tol), int(max_iter)
+        self.diverge_after = int(diverge_after)
         self.iterations, self.residual, self.contraction = 0, 0.0, float("nan")
         self.residuals = []
         self.history = []
@@ -259,13 +279,12 @@ class VariationalMidpoint(ExplicitLeapfrog):
                 if res[-1] <= self.tol:
                     break
                 if not np.isfinite(res[-1]) or len(res) >= self.max_iter:
-                    self.stage("stage11", t, dt)   # arrays back to the start of the step
-                    self.update_nnps()
-                    raise BlowUpError(
-                        f"variational fixed-point iteration did not converge at step {self.k + 1} "
-                        f"(t={t:.6g} -> {t + dt:.6g}): residual {res[-1]:.3e} m > tol {self.tol:.3e} m after "
-                        f"{len(res)} iteration(s) (contraction ratios "
-                        f"{', '.join(f'{b / a:.3g}' for a, b in zip(res, res[1:]) if a > 0) or 'n/a'})")
+                    self._fail("did not converge", t, dt, res)
+                n = self.diverge_after
+                if len(res) > n and res[-1] >= res[-1 - n]:
+                    self._fail("diverges", t, dt, res,
+                               f"; the residual did not fall over {n} iterations: the map is no "
+                               "contraction at this dt (reduce it)")
             self.evaluate(1, t, dt)          # rho_{k,k+1} at the accepted q_{k+1}
             self.stage("stage10", t, dt)
             ratios = [b / a for a, b in zip(res, res[1:]) if a > 0]
@@ -275,11 +294,28 @@ class VariationalMidpoint(ExplicitLeapfrog):
         self.update_nnps()
         self.k += 1
 
+    def _fail(self, what, t, dt, res, why=""):
+        """Arrays back to the start of the step; a BlowUpError naming step and residual."""
+        self.stage("stage11", t, dt)
+        self.update_nnps()
+        ratios = [f"{b / a:.3g}" for a, b in zip(res, res[1:]) if a > 0]
+        shown = ", ".join(ratios[-6:]) if ratios else "n/a"
+        if len(ratios) > 6:
+            shown = "last: " + shown
+        raise BlowUpError(
+            f"variational fixed-point iteration {what} at step {self.k + 1} (t={t:.6g} -> {t + dt:.6g}): "
+            f"residual {res[-1]:.3e} m > tol {self.tol:.3e} m after {len(res)} iteration(s) "
+            f"(contraction ratios {shown}){why}")
+
 
 class VariationalScheme(Scheme):
     """da Silva & Giraldi (2024): Tait EOS, Gaussian kernel (K1/K2/K3), continuity density
     (eq. 67), artificial viscosity (eq. 55), Lennard-Jones wall force (eq. 58), gravity;
     ``integrator`` 'variational' (alpha, tol, max_iter) or 'explicit' (eqs. 59-62).
+
+    ``density='summation'`` replaces the continuity density by the summation density at the
+    interpolated configuration (eq. 20): with ``av_a = av_b = 0`` and no walls this is the
+    "pure" variational scheme of eq. 37, and alpha in {0, 1} is Stormer-Verlet (eq. 38).
 
     Fluids need ``h = rc/3`` (the quintic spline's support 3h is the neighbour radius);
     boundary arrays (``walls``) only need positions and that ``h``.
@@ -290,7 +326,7 @@ class VariationalScheme(Scheme):
     def __init__(self, fluids, walls, dim=2, rho0=1000.0, c0=23.841, gx=0.0, gy=0.0,
                  kernel="K3", dx=0.005, h_cut=0.072, av_a=1.0, av_b=1.0, D=5.684, r0=0.005,
                  wall_power=1, integrator="variational", alpha=0.5, tol=1e-3, max_iter=50,
-                 gamma=7.0, predictor="verlet", dt=None):
+                 gamma=7.0, predictor="verlet", dt=None, density="continuity", diverge_after=3):
         if dim != 2:
             raise ValueError("VariationalScheme: only dim = 2 is implemented")
         if integrator not in ("variational", "explicit"):
@@ -306,9 +342,12 @@ class VariationalScheme(Scheme):
         self.hphi = h_cut if kernel in ("K1", "K2") else self.lam   # digest A34
         self.av_a, self.av_b, self.D, self.r0, self.wall_power = av_a, av_b, D, r0, wall_power
         self.integrator, self.alpha, self.tol, self.max_iter = integrator, alpha, tol, max_iter
+        if density not in ("continuity", "summation"):
+            raise ValueError(f"VariationalScheme: density {density!r}: continuity or summation")
+        self.density = density
         if predictor not in PREDICTORS:
             raise ValueError(f"VariationalScheme: predictor {predictor!r}: {', '.join(PREDICTORS)}")
-        self.predictor, self.dt = predictor, dt
+        self.predictor, self.dt, self.diverge_after = predictor, dt, diverge_after
         self.B = rho0 * c0 * c0 / gamma
         self.kernel = get_kernel("quintic", dim)
         self.speed_limit = c0
@@ -331,11 +370,19 @@ class VariationalScheme(Scheme):
 
     def get_equations(self):
         f, w = self.fluids, self.walls
-        eos = [TaitEOS(d, None, rho0=self.rho0, c0=self.c0, gamma=self.gamma) for d in f]
-        old = [Group(eos), Group([e for d in f for e in self._forces(d)])]
-        new = [Group([GaussianContinuityDensity(d, f, **self._kw()) for d in f]),
-               Group([TaitEOS(d, None, rho0=self.rho0, c0=self.c0, gamma=self.gamma) for d in f]),
-               Group([e for d in f for e in self._forces(d)])]
+        summation = self.density == "summation"
+
+        def eos():
+            return Group([TaitEOS(d, None, rho0=self.rho0, c0=self.c0, gamma=self.gamma) for d in f])
+
+        def density():
+            cls = GaussianSummationDensity if summation else GaussianContinuityDensity
+            return Group([cls(d, f, **self._kw()) for d in f])
+
+        # set 0 at xbar(q_{k-1}, q_k): the continuity density rho_{k-1,k} is the stored one,
+        # the summation density is recomputed there (eq. 20)
+        old = ([density()] if summation else []) + [eos(), Group([e for d in f for e in self._forces(d)])]
+        new = [density(), eos(), Group([e for d in f for e in self._forces(d)])]
         walls = [ZeroAcceleration(d) for d in f]
         if w:
             walls += [LennardJonesWallForce(d, w, D=self.D, r0=self.r0, power=self.wall_power) for d in f]
@@ -347,7 +394,8 @@ class VariationalScheme(Scheme):
         steppers = {name: step for name in self.fluids}
         if self.integrator == "explicit":
             return ExplicitLeapfrog(**steppers)
-        return VariationalMidpoint(alpha=self.alpha, tol=self.tol, max_iter=self.max_iter, **steppers)
+        return VariationalMidpoint(alpha=self.alpha, tol=self.tol, max_iter=self.max_iter,
+                                   diverge_after=self.diverge_after, **steppers)
 
     def get_timestep(self):
         """``dt`` if given (the paper's 1e-4 s), else 0.25 lam / c0 (acoustic CFL on the kernel width)."""

@@ -103,6 +103,10 @@ class Integrator:
     def initial_accelerations(self, t, dt):
         """Evaluations needed before the first step (none by default)."""
 
+    def restarted(self, step, t):
+        """The solver loaded the state of ``step`` (time ``t``) from a restart file: an
+        integrator that counts its steps (e.g. a start-up step) continues from there."""
+
     def one_timestep(self, t, dt):
         raise NotImplementedError
 

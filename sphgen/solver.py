@@ -114,6 +114,7 @@ class Solver:
         sd = data["solver_data"]
         self.t, self.step = float(sd["t"]), int(sd["step"])
         self.restarted = True
+        self.integrator.restarted(self.step, self.t)
         self.scene.update_nnps()
 
     def _snapshot(self):

@@ -134,3 +134,142 @@ def test_normalised_gaussian_variants(kernel):
     f = np.array([gauss_grad_factor(ri, ell, lam, rc, shift) * ri for ri in r[i]])
     np.testing.assert_allclose(f, dwdr[i], rtol=1e-6)
     assert gauss_grad_factor(rc * 1.0001, ell, lam, rc, shift) == 0.0
+
+
+def test_alpha_zero_with_summation_density_is_stormer_verlet():
+    """da Silva & Giraldi (2024) eqs. 37-38: with the summation density of eq. 20 and no
+    viscosity, alpha = 0 evaluates a_1 at q_k whatever the iterate is, so the iteration is
+    exact after one correction (second residual exactly 0) and the step is Stormer-Verlet:
+    the explicit leapfrog with the same density, bit for bit."""
+    kw = dict(gravity=True, density="summation", av_a=0.0, av_b=0.0)
+    a, ia, _ = build("explicit", **kw)
+    advance(ia, 8)
+    ref = {p: a.data[p].copy() for p in ("x", "y", "u", "v")}
+    assert np.abs(ref["x"] - cloud().x).max() > 1e-5
+    b, ib, _ = build("variational", alpha=0.0, tol=1e-300, max_iter=3, **kw)
+    advance(ib, 8)
+    for p in ("x", "y", "u", "v"):
+        assert np.array_equal(ref[p], b.data[p]), p
+    assert all(it == 2 for _, it, _, _ in ib.history[1:])
+    assert ib.residuals[0] > 0.0 and ib.residuals[1] == 0.0
+
+
+def _periodic_minimal(x, y, L):
+    dx = x[:, None] - x[None, :]
+    dy = y[:, None] - y[None, :]
+    dx -= L * np.round(dx / L)
+    dy -= L * np.round(dy / L)
+    return dx, dy
+
+
+def _reference_rates(x, y, u, v, rho, m, s, L):
+    """numpy, all pairs: Cont (eq. 67) and A_int (pressure eq. 64 + AV eq. 55) of the scheme."""
+    dx, dy = _periodic_minimal(x, y, L)
+    r = np.hypot(dx, dy)
+    f = np.where(r <= s.rc, -2.0 * s.ell / s.lam ** 2 * (np.exp(-(r / s.lam) ** 2) - s.shift), 0.0)
+    du, dv = u[:, None] - u[None, :], v[:, None] - v[None, :]
+    vx = du * dx + dv * dy
+    cont = np.sum(m[None, :] * f * vx, axis=1)
+    return cont, f, dx, dy, vx, r
+
+
+def _reference_acceleration(f, dx, dy, vx, r, rho, m, s):
+    p = s.B * ((rho / s.rho0) ** s.gamma - 1.0)
+    pp = p / rho ** 2
+    coef = -m[None, :] * (pp[:, None] + pp[None, :]) * f
+    phi = s.hphi * vx / (r ** 2 + 0.01 * s.hphi ** 2)
+    pij = np.where(vx < 0.0, 2.0 * (-s.av_a * s.c0 * phi + s.av_b * phi ** 2) / (rho[:, None] + rho[None, :]), 0.0)
+    coef -= m[None, :] * pij * f
+    return np.sum(coef * dx, axis=1), np.sum(coef * dy, axis=1)
+
+
+def test_alpha_zero_with_continuity_density_is_a_velocity_implicit_leapfrog():
+    """What the implemented scheme (continuity density eq. 67, AV eq. 55) is at alpha = 0:
+    xbar = q_k, so a_1 = A_int(q_k, v_{k+1/2}, rho_{k-1,k} + dt Cont(q_k, v_{k+1/2})) and
+    v_{k+1/2} = v_{k-1/2} + dt a_1, q_{k+1} = q_k + dt v_{k+1/2}: the explicit leapfrog
+    (eqs. 59-62) except that the density increment and the viscosity take the new half-step
+    velocity -- implicit in the velocity only.  Checked against an all-pairs numpy evaluation."""
+    nx, dt = 10, 1e-4
+    pa, integ, s = build("variational", alpha=0.0, tol=1e-14, max_iter=60, nx=nx)
+    advance(integ, 3)
+    order = np.argsort(pa.gid)
+    xk, yk = pa.x[order].copy(), pa.y[order].copy()
+    uo, vo, rho_old = pa.u[order].copy(), pa.v[order].copy(), pa.rho[order].copy()
+    integ.one_timestep(3 * dt, dt)
+    order = np.argsort(pa.gid)
+    un, vn = pa.uh[order], pa.vh[order]
+    m = pa.m[order]
+    assert integ.iterations > 2      # implicit: the iterate's velocity changes a_1
+    cont, f, dx, dy, vx, r = _reference_rates(xk, yk, un, vn, None, m, s, nx * DX)
+    rho_new = rho_old + dt * cont
+    ax, ay = _reference_acceleration(f, dx, dy, vx, r, rho_new, m, s)
+    assert np.abs(uo + dt * ax - un).max() < 1e-9 and np.abs(vo + dt * ay - vn).max() < 1e-9
+    assert_close(pa.rho[order], rho_new, 1e-13, what="rho_{k,k+1}")
+    wrap = lambda d: d - nx * DX * np.round(d / (nx * DX))  # noqa: E731
+    assert np.abs(wrap(pa.x[order] - (xk + dt * un))).max() < 1e-17
+    # ... and not the explicit leapfrog: the old velocity in Cont and AV changes the step
+    cont_o, f, dx, dy, vx, r = _reference_rates(xk, yk, uo, vo, None, m, s, nx * DX)
+    ax_o, _ = _reference_acceleration(f, dx, dy, vx, r, rho_old + dt * cont_o, m, s)
+    assert np.abs(uo + dt * ax_o - un).max() > 1e3 * np.abs(uo + dt * ax - un).max()
+
+
+def test_contraction_monitor_stops_a_diverging_iteration():
+    """dt = 4e-4 on the test cloud: the fixed-point map is no contraction (ratios > 1); the
+    run stops at once, naming step and residual, with the arrays back at the step's start."""
+    pa, integ, _ = build("variational", alpha=0.5, tol=1e-13, max_iter=50)
+    integ.one_timestep(0.0, 4e-4)
+    x1, u1, rho1 = pa.x.copy(), pa.u.copy(), pa.rho.copy()
+    with pytest.raises(BlowUpError, match=r"diverges at step 2 \(t=0.0004 -> 0.0008\): residual \S+ m "
+                                          r".*did not fall over 3 iterations"):
+        integ.one_timestep(4e-4, 4e-4)
+    assert len(integ.history) == 1
+    assert np.array_equal(pa.x, x1) and np.array_equal(pa.u, u1) and np.array_equal(pa.rho, rho1)
+
+
+DAM = ["--threads", "1", "--no-progress", "--tol", "1e-12"]
+
+
+def dam(args):
+    from sphgen.app import load_application
+    app = load_application("dam_break_variational")()
+    app.run(DAM + args)
+    return app
+
+
+@pytest.mark.parametrize("integrator", ["variational", "explicit"])
+def test_restart_is_bit_for_bit(tmp_path, integrator):
+    """A run restarted from its output of step 10 ends with the same files, bit for bit,
+    and the same time series (the start-up step is not taken again)."""
+    import json
+    from sphgen import io
+    run = ["--integrator", integrator, "--tf", "0.002", "--pfreq", "10", "--record-every", "3e-4"]
+    dam(run + ["-d", str(tmp_path / "full")])
+    mid = io.output_files(tmp_path / "full")[1]
+    assert io.step_of(mid) == 10
+    dam(run + ["-d", str(tmp_path / "part"), "--restart", mid])
+    a = io.load(io.output_files(tmp_path / "full")[-1])["arrays"]["fluid"]
+    b = io.load(io.output_files(tmp_path / "part")[-1])["arrays"]["fluid"]
+    assert np.abs(a.y - io.load(mid)["arrays"]["fluid"].y).max() > 1e-6
+    for p in a.data:
+        assert np.array_equal(a.data[p], b.data[p]), p
+    for name in ("history.json", "steps.json"):
+        ra = json.load(open(tmp_path / "full" / name))["rows"]
+        rb = json.load(open(tmp_path / "part" / name))["rows"]
+        assert json.dumps(ra) == json.dumps(rb), name
+    steps = json.load(open(tmp_path / "full" / "steps.json"))["rows"]
+    assert len(steps) == 20 and (integrator == "explicit" or min(r[2] for r in steps[1:]) >= 1)
+
+
+def test_non_converged_step_stops_the_application_with_one_line(tmp_path, capsys):
+    """--max-iter 1 with a tight tol: one 'sphgen:' line naming step and residual, the last
+    good state (the step before) on disk."""
+    from sphgen import io
+    out = tmp_path / "nc"
+    with pytest.raises(SystemExit):
+        dam(["--max-iter", "1", "--tf", "0.001", "-d", str(out)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("sphgen: variational fixed-point iteration did not converge "
+                                               "at step 3 (t=0.0002 -> 0.0003): residual ")
+    assert "last good state (step 2" in err[0]
+    good = io.load(str(out / "dam_break_variational_last_good.h5"))
+    assert good["solver_data"]["step"] == 2
