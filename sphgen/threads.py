@@ -9,8 +9,22 @@ flips, since load comes and goes).  A trial that is clearly losing after its fir
 ``early`` steps (every one slower than ``1 / margin`` of the current median) ends there,
 so that on an idle machine the trials cost a few serial steps, not ``trial`` of them.  The loops compute each particle independently, so
 the choice never changes the results.
+
+A trial of fewer threads is only started when the machine is seen busy: the kernel's
+count of runnable threads (``/proc/loadavg``) exceeds our own running thread.  On an
+idle machine the trials are skipped, so they cost nothing there.
 """
 import statistics
+
+
+def others_running(path="/proc/loadavg"):
+    """True if some thread besides the caller is runnable now (or if it cannot be told)."""
+    try:
+        with open(path) as f:
+            running = int(f.read().split()[3].split("/")[0])
+    except (OSError, ValueError, IndexError):
+        return True
+    return running > 1
 
 
 class ThreadTuner:
@@ -27,6 +41,7 @@ class ThreadTuner:
         self._trying = None       # (other count, its step times) during a trial
         self._steps = 0
         self.choices = []         # (step, threads) whenever the choice changes
+        self.busy = others_running
 
     @property
     def active(self):
@@ -48,6 +63,9 @@ class ThreadTuner:
         self._steps += 1
         if self._steps >= self.every and len(self._times) >= self.trial:
             other = 1 if self.current != 1 else self.most
+            if other < self.current and not self.busy():
+                self._steps = 0           # idle: fewer threads cannot win; look again later
+                return
             self._trying = (other, [])
             self.scene.set_threads(other)
 

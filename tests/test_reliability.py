@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from sphgen import io
-from sphgen.threads import ThreadTuner
+from sphgen.threads import ThreadTuner, others_running
 from sphgen.app import load_application, main
 from sphgen.equation import ParameterError
 from sphgen.errors import BlowUpError, RestartError
@@ -180,6 +180,7 @@ class _TwoThreadScene:
 def test_thread_tuner_drops_to_one_thread_under_load_and_returns():
     scene = _TwoThreadScene()
     tuner = ThreadTuner(scene, trial=3, first=4)
+    tuner.busy = lambda: True        # the machine is seen loaded
     cost = {2: 4.0, 1: 1.0}          # loaded machine: 2 threads 4x slower than one
     for step in range(1, 40):
         tuner.record(step, cost[scene.threads])
@@ -197,6 +198,7 @@ def test_thread_tuner_drops_to_one_thread_under_load_and_returns():
 def test_thread_tuner_abandons_a_clearly_losing_trial_early():
     scene = _TwoThreadScene()
     tuner = ThreadTuner(scene, trial=6, first=20, early=2)
+    tuner.busy = lambda: True        # another process seen, yet two threads still win
     serial_steps = 0
     for step in range(1, 1001):      # idle machine: one thread 1.8x slower
         serial_steps += scene.threads == 1
@@ -204,3 +206,22 @@ def test_thread_tuner_abandons_a_clearly_losing_trial_early():
     assert tuner.choices == []
     # trials after 20, 40, 80, 160, 320 steps of two threads: two serial steps each
     assert serial_steps == 2 * 5
+
+
+def test_thread_tuner_tries_nothing_on_an_idle_machine():
+    scene = _TwoThreadScene()
+    tuner = ThreadTuner(scene, trial=6, first=20, early=2)
+    tuner.busy = lambda: False
+    for step in range(1, 1001):
+        assert scene.threads == 2
+        tuner.record(step, 1.0)
+    assert tuner.choices == []
+
+
+def test_others_running_reads_the_runnable_count(tmp_path):
+    f = tmp_path / "loadavg"
+    f.write_text("0.10 0.20 0.30 1/345 6789\n")
+    assert others_running(str(f)) is False
+    f.write_text("2.10 1.20 0.30 3/345 6789\n")
+    assert others_running(str(f)) is True
+    assert others_running(str(tmp_path / "missing")) is True   # cannot tell: try

@@ -20,7 +20,8 @@ import math
 
 import numpy as np
 
-from ._cell_list import GridSpec, bin_particles, build_csr, remap_csr, scan, wrap_periodic
+from ._cell_list import (GridSpec, RowBuffers, bin_particles, build_csr, remap_csr, scan,
+                         wrap_periodic)
 
 __all__ = ["Domain", "NeighbourSearch", "NotFrozenError"]
 
@@ -154,6 +155,7 @@ class NeighbourSearch:
         self._by_name = dict(zip(names, arrays))
         self._cache = {}
         self._frozen = {}
+        self._rows = {}          # (dest, src) -> RowBuffers kept across updates
         self._bins = {}
         self._sizes = {}
         self._rank_key = None
@@ -305,7 +307,8 @@ class NeighbourSearch:
                 if pa.n != self._sizes[pa.name]:
                     raise RuntimeError(f"array '{pa.name}' has {pa.n} particles but had "
                                        f"{self._sizes[pa.name]} at the last update(): call update()")
-            lists = build_csr(self.grid, self._bins[d.name], self._bins[s.name])
+            rows = self._rows.setdefault(key, RowBuffers())
+            lists = build_csr(self.grid, self._bins[d.name], self._bins[s.name], buffers=rows)
             self._cache[key] = lists
         return lists
 

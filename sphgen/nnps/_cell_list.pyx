@@ -92,6 +92,47 @@ ctypedef struct Row:
     Py_ssize_t tmp_cap
 
 
+cdef class RowBuffers:
+    """Per-block row buffers of :func:`build_csr`, kept from one call to the next.
+
+    Allocating them anew for every list made each step grow (realloc) and first-touch
+    fresh memory in both threads at once; a search keeps one ``RowBuffers`` per
+    (dest, src) pair so that, after the first step, the count pass writes into memory
+    that is already mapped and large enough."""
+    cdef Row* rows
+    cdef Py_ssize_t n
+
+    def __cinit__(self):
+        self.rows = NULL
+        self.n = 0
+
+    cdef int reserve(self, Py_ssize_t nb) except -1:
+        """At least ``nb`` buffers, each emptied (capacity kept)."""
+        cdef Row* rows
+        cdef Py_ssize_t b
+        if nb > self.n:
+            rows = <Row*>realloc(self.rows, nb * sizeof(Row))
+            if rows == NULL:
+                raise MemoryError()
+            for b in range(self.n, nb):
+                rows[b].data = NULL
+                rows[b].cap = 0
+                rows[b].tmp = NULL
+                rows[b].tmp_cap = 0
+            self.rows = rows
+            self.n = nb
+        for b in range(nb):
+            self.rows[b].used = 0
+        return 0
+
+    def __dealloc__(self):
+        cdef Py_ssize_t b
+        for b in range(self.n):
+            free(self.rows[b].data)
+            free(self.rows[b].tmp)
+        free(self.rows)
+
+
 cdef class GridSpec:
     """The cell grid shared by all arrays of one neighbour search.
 
@@ -630,10 +671,12 @@ def bin_particles(GridSpec grid, list coords, double[::1] h, double radius_scale
     return start_arr, index_arr, pts_arr
 
 
-def build_csr(GridSpec grid, dest_bins, src_bins, Py_ssize_t block_size=128):
+def build_csr(GridSpec grid, dest_bins, src_bins, Py_ssize_t block_size=128,
+              RowBuffers buffers=None):
     """CSR neighbour lists of every destination particle among the source particles.
 
-    ``dest_bins``/``src_bins`` are ``bin_particles`` results on the same grid.
+    ``dest_bins``/``src_bins`` are ``bin_particles`` results on the same grid;
+    ``buffers``, if given, are reused (and kept) as the blocks' scratch rows.
     Returns ``(offsets, nbrs)``, int32, each row ascending."""
     cdef int[::1] d_start, d_index, s_start, s_index
     cdef double[:, ::1] d_pts, s_pts
@@ -660,31 +703,20 @@ def build_csr(GridSpec grid, dest_bins, src_bins, Py_ssize_t block_size=128):
         if s.index[b] != b:
             in_order = False
     nb = _make_blocks(&d, ncells, block_size, bounds)
-    bufs = <Row*>malloc(nb * sizeof(Row))
-    if bufs == NULL:
-        raise MemoryError()
-    for b in range(nb):
-        bufs[b].data = NULL
-        bufs[b].used = 0
-        bufs[b].cap = 0
-        bufs[b].tmp = NULL
-        bufs[b].tmp_cap = 0
-    try:
-        for b in prange(nb, nogil=True, schedule="dynamic"):
-            failed += _block_rows(g, &d, &s, reach2_s, in_order, bounds[b], bounds[b + 1], pc, &bufs[b]) != 0
-        if failed:
-            raise MemoryError("out of memory while building neighbour lists")
-        _prefix_sum(pc, nd, offsets)
-        nbrs_arr = np.empty(offsets[nd], dtype=np.int32)
-        nbrs = nbrs_arr
-        pn = _iptr(nbrs)
-        for b in prange(nb, nogil=True, schedule="static"):
-            _block_fill(&d, bounds[b], bounds[b + 1], &offsets[0], &bufs[b], pn)
-    finally:
-        for b in range(nb):
-            free(bufs[b].data)
-            free(bufs[b].tmp)
-        free(bufs)
+    if buffers is None:
+        buffers = RowBuffers()
+    buffers.reserve(nb)
+    bufs = buffers.rows
+    for b in prange(nb, nogil=True, schedule="dynamic"):
+        failed += _block_rows(g, &d, &s, reach2_s, in_order, bounds[b], bounds[b + 1], pc, &bufs[b]) != 0
+    if failed:
+        raise MemoryError("out of memory while building neighbour lists")
+    _prefix_sum(pc, nd, offsets)
+    nbrs_arr = np.empty(offsets[nd], dtype=np.int32)
+    nbrs = nbrs_arr
+    pn = _iptr(nbrs)
+    for b in prange(nb, nogil=True, schedule="static"):
+        _block_fill(&d, bounds[b], bounds[b + 1], &offsets[0], &bufs[b], pn)
     return offsets_arr, nbrs_arr
 
 
