@@ -118,7 +118,11 @@ class LatticeVariational(Application):
 
     def history_meta(self):
         o = self.options
-        return {k: getattr(o, k) for k in ("integrator", "alpha", "tol", "density", "nx", "U", "time_step")}
+        meta = {k: getattr(o, k) for k in ("integrator", "alpha", "tol", "density", "nx", "U")}
+        if o.integrator == "explicit":
+            meta["alpha"] = meta["tol"] = None
+        meta["time_step"] = self.solver.dt if self.solver is not None else o.time_step
+        return meta
 
     def _write_progress(self, completed=False, error=None):
         super()._write_progress(completed, error)
