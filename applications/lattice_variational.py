@@ -60,8 +60,8 @@ class LatticeVariational(Application):
                            help="fixed-point tolerance, metres, max-norm (default %(default)s)")
         group.add_argument("--max-iter", type=int, default=80, help="iteration cap (default %(default)s)")
         group.add_argument("--predictor", choices=tuple(PREDICTORS), default="verlet")
-        group.add_argument("--density", choices=("summation", "continuity"), default="summation",
-                           help="summation (eq. 20, default) or continuity density (eq. 67)")
+        group.add_argument("--density", choices=("summation", "continuity", "centred"), default="summation",
+                           help="summation (eq. 20, default), continuity (eq. 67) or centred continuity density")
         group.add_argument("--kernel", choices=("K1", "K2", "K3"), default="K3")
         group.add_argument("--c0", type=float, default=23.841, help="speed of sound (default %(default)s)")
         group.add_argument("--av-a", type=float, default=0.0, help="AV a (default %(default)s)")
@@ -82,6 +82,8 @@ class LatticeVariational(Application):
             raise InputError(f"--U must be finite, got {o.U}")
         if not 0.0 <= o.alpha <= 1.0:
             raise InputError(f"--alpha must be in [0, 1], got {o.alpha}")
+        if o.density == "centred" and o.integrator != "variational":
+            raise InputError("--density centred needs --integrator variational")
         if o.max_iter < 1 or o.record_every < 1:
             raise InputError("--max-iter and --record-every must be at least 1")
         if o.reference_run is not None and not (os.path.isdir(o.reference_run)
