@@ -135,6 +135,8 @@ def _rows(case):
 
 
 INTEGRATORS = {"alpha0.5": dict(integrator="variational", alpha=0.5), "explicit": dict(integrator="explicit")}
+DENSITY_RUNS = [(d, name) for d in ("summation", "continuity") for name in INTEGRATORS] + [("centred", "alpha0.5")]
+"""(density, integrator) pairs of the studies: the centred density exists for the variational one only."""
 
 
 class VariationalOrder(SphgenProblem):
@@ -150,17 +152,17 @@ class VariationalOrder(SphgenProblem):
     def setup(self):
         cmd = self.sphgen("lattice_variational")
         self.cases, self.groups = [], {}
-        for density in ("summation", "continuity"):
-            for name, kw in INTEGRATORS.items():
-                ref_dir = self.input_path(f"{name}_{density}_ref")
-                ref = Simulation(ref_dir, cmd, job_info=dict(n_core=1, n_thread=1), tf=self.tf, density=density,
-                                 time_step=self.dts[-1] / self.refine, threads=1, **kw)
-                runs = [Simulation(self.input_path(f"{name}_{density}_dt{dt:g}"), cmd,
-                                   job_info=dict(n_core=1, n_thread=1), depends=[ref], tf=self.tf,
-                                   density=density, time_step=dt, reference_run=ref_dir, threads=1, **kw)
-                        for dt in self.dts]
-                self.groups[(name, density)] = runs
-                self.cases += [ref] + runs
+        for density, name in DENSITY_RUNS:
+            kw = INTEGRATORS[name]
+            ref_dir = self.input_path(f"{name}_{density}_ref")
+            ref = Simulation(ref_dir, cmd, job_info=dict(n_core=1, n_thread=1), tf=self.tf, density=density,
+                             time_step=self.dts[-1] / self.refine, threads=1, **kw)
+            runs = [Simulation(self.input_path(f"{name}_{density}_dt{dt:g}"), cmd,
+                               job_info=dict(n_core=1, n_thread=1), depends=[ref], tf=self.tf,
+                               density=density, time_step=dt, reference_run=ref_dir, threads=1, **kw)
+                    for dt in self.dts]
+            self.groups[(name, density)] = runs
+            self.cases += [ref] + runs
 
     def run(self):
         self.make_output_dir()
@@ -199,15 +201,17 @@ class VariationalEnergy(SphgenProblem):
         cmd = self.sphgen("lattice_variational")
         self.cases = [Simulation(self.input_path(f"{name}_{density}"), cmd, job_info=dict(n_core=1, n_thread=1),
                                  tf=self.steps * self.dt, time_step=self.dt, density=density, threads=1,
-                                 record_every=10, pfreq=self.steps, tol=1e-12, nx=self.nx, **kw)
-                      for density in ("summation", "continuity") for name, kw in INTEGRATORS.items()]
+                                 record_every=10, pfreq=self.steps, tol=1e-12, nx=self.nx, **INTEGRATORS[name])
+                      for density, name in DENSITY_RUNS]
 
     def run(self):
         self.make_output_dir()
         plt = _plt()
-        f, axes = plt.subplots(1, 2, figsize=(10, 4))
+        densities = list(dict.fromkeys(d for d, _ in DENSITY_RUNS))
+        f, axes = plt.subplots(1, len(densities), figsize=(5 * len(densities), 4))
         out = {}
-        for case, ax in zip(self.cases, [axes[0], axes[0], axes[1], axes[1]]):
+        for case, (density, _) in zip(self.cases, DENSITY_RUNS):
+            ax = axes[densities.index(density)]
             c = _rows(case)
             rel = c["energy"] / c["energy"][0] - 1.0
             name = os.path.basename(case.input_path())
