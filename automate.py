@@ -7,8 +7,9 @@ Simulations go to ``outputs/``, figures to ``manuscript/figures/``.  Finished ca
 from automan.api import Automator
 
 from automation.taylor_green import TaylorGreenEDAC
+from automation.variational import VariationalDamBreak, VariationalEnergy, VariationalOrder
 
-PROBLEMS = [TaylorGreenEDAC]
+PROBLEMS = [TaylorGreenEDAC, VariationalDamBreak, VariationalOrder, VariationalEnergy]
 
 if __name__ == "__main__":
     Automator(simulation_dir="outputs", output_dir="manuscript/figures",

@@ -38,7 +38,7 @@ from sphgen.particles import ParticleArray
 from sphgen.tools.probes import count_neighbours, front_position
 from sphgen.tools import reference
 
-from ..schemes.variational import PREDICTORS, VariationalScheme
+from ..schemes.variational import DENSITIES, PREDICTORS, VariationalScheme
 from .dam_break_2d import max_rel_deviation
 
 try:
@@ -94,8 +94,9 @@ class DamBreakVariational(Application):
         group.add_argument("--record-every", type=float, default=1e-3,
                            help="time between history samples (default %(default)s s); the "
                                 "per-step rows (iterations, residual, budget) go to steps.json")
-        group.add_argument("--density", choices=("continuity", "summation"), default="continuity",
-                           help="continuity (eq. 67, the paper's runs) or summation density (eq. 20)")
+        group.add_argument("--density", choices=DENSITIES, default="continuity",
+                           help="continuity (eq. 67, the paper's runs), summation density (eq. 20) or "
+                                "centred (eq. 67 interpolated like q, second order; variational only)")
         group.add_argument("--perturb", type=float, default=0.0,
                            help="random displacement of the fluid particles, in dx (default 0)")
         group.add_argument("--seed", type=int, default=1, help="seed of --perturb (default 1)")
@@ -112,6 +113,8 @@ class DamBreakVariational(Application):
             raise InputError(f"--alpha must be in [0, 1], got {o.alpha}")
         if o.max_iter < 1:
             raise InputError(f"--max-iter must be >= 1, got {o.max_iter}")
+        if o.density == "centred" and o.integrator != "variational":
+            raise InputError("--density centred needs --integrator variational")
         if not (np.isfinite(o.perturb) and 0.0 <= o.perturb < 0.5):
             raise InputError(f"--perturb must be in [0, 0.5), got {o.perturb}")
         if o.reference_run is not None and not (os.path.isdir(o.reference_run)

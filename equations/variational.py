@@ -85,9 +85,14 @@ class GaussianSummationDensity(Equation):
 
 class GaussianContinuityDensity(Equation):
     """rho_{k,k+1} = rho_{k-1,k} + dt sum_j m_j v_ij . grad_i W (da Silva & Giraldi 2024,
-    eq. 67 with the sign fixed); ``rhok`` holds rho_{k-1,k}; writes ``arho`` and ``rho``."""
+    eq. 67 with the sign fixed); ``rhok`` holds rho_{k-1,k}; writes ``arho`` and ``rho``.
+    ``weight`` w gives rho = rhok + w dt Cont (the centred variant: w = alpha, -(1 - alpha))."""
 
     positive = ("lam", "rc")
+
+    def __init__(self, dest, sources=None, weight=1.0, **params):
+        self.weight = float(weight)
+        super().__init__(dest, sources, **params)
 
     def initialize(self, d_idx, d_arho):
         d_arho[d_idx] = 0.0
@@ -97,7 +102,7 @@ class GaussianContinuityDensity(Equation):
         d_arho[d_idx] += s_m[s_idx] * f * (VIJ[0] * XIJ[0] + VIJ[1] * XIJ[1] + VIJ[2] * XIJ[2])
 
     def post_loop(self, d_idx, d_arho, d_rho, d_rhok, dt):
-        d_rho[d_idx] = d_rhok[d_idx] + dt * d_arho[d_idx]
+        d_rho[d_idx] = d_rhok[d_idx] + self.weight * dt * d_arho[d_idx]
 
 
 class GaussianPressureGradient(Equation):

@@ -43,6 +43,13 @@ from ..equations.variational import (GaussianContinuityDensity, GaussianPressure
 from ..equations.walls import LennardJonesWallForce
 from ..equations.wcsph import TaitEOS
 
+DENSITIES = ("continuity", "summation", "centred")
+"""continuity: eq. 67 as printed (rho_{k,k+1} used at beta_{k,k+1}: first order in dt); summation:
+eq. 20 at the interpolated configuration; centred (ours, variational integrator only): rhok holds
+rho_k, the forces at beta_{k,k+1} use rho_k + alpha dt Cont(beta_{k,k+1}, v_{k,k+1}), those at
+beta_{k-1,k} use rho_k - (1 - alpha) dt Cont(beta_{k-1,k}, v_{k-1,k}), and the accepted step sets
+rho_{k+1} = rho_k + dt Cont(beta_{k,k+1}, v_{k,k+1}): the density interpolated like q."""
+
 PREDICTORS = {"verlet": 0, "linear": 1, "previous": 2}
 """Initial guess q^(0) of the iteration (digest A15): verlet q_k + dt (v_{k-1,k} + dt (a_2 +
 Gamma_k + g)) (default), linear 2 q_k - q_{k-1}, previous q_k."""
@@ -59,12 +66,13 @@ class VariationalStep(IntegratorStep):
     stage11 back to the start of the step (after a non-converged iteration).
     """
 
-    switches = ("predictor",)
+    switches = ("predictor", "centred")
 
-    def __init__(self, alpha=0.5, gx=0.0, gy=0.0, predictor=0):
+    def __init__(self, alpha=0.5, gx=0.0, gy=0.0, predictor=0, centred=0):
         self.alpha = float(alpha)
         self.gx, self.gy = float(gx), float(gy)
         self.predictor = int(predictor)   # PREDICTORS: 0 verlet, 1 linear, 2 previous
+        self.centred = int(centred)       # 1: rhok holds rho_k, advanced by dt Cont at acceptance
 
     def stage1(self, d_idx, d_u, d_v, d_uh, d_vh, d_rho, d_rhok, dt):
         d_uh[d_idx] = d_u[d_idx] - 0.5 * dt * self.gx
@@ -91,7 +99,8 @@ class VariationalStep(IntegratorStep):
         d_y[d_idx] = d_yk[d_idx] + dt * d_vh[d_idx]
         d_u[d_idx] = d_uh[d_idx]
         d_v[d_idx] = d_vh[d_idx]
-        d_rhok[d_idx] = d_rho[d_idx]
+        if self.centred == 0:
+            d_rhok[d_idx] = d_rho[d_idx]
 
     def stage5(self, d_idx, d_x, d_y, d_xk, d_yk, d_xi, d_yi, d_u, d_v, d_ui, d_vi, d_uh, d_vh):
         d_xi[d_idx] = d_x[d_idx]
@@ -157,8 +166,13 @@ class VariationalStep(IntegratorStep):
         d_u[d_idx] = d_ui[d_idx]
         d_v[d_idx] = d_vi[d_idx]
 
-    def stage10(self, d_idx, d_x, d_y, d_xi, d_yi, d_u, d_v, d_ui, d_vi, d_uh, d_vh, d_rho, d_rhok):
-        d_rhok[d_idx] = d_rho[d_idx]
+    def stage10(self, d_idx, d_x, d_y, d_xi, d_yi, d_u, d_v, d_ui, d_vi, d_uh, d_vh, d_rho, d_rhok,
+                d_arho, dt):
+        if self.centred == 0:
+            d_rhok[d_idx] = d_rho[d_idx]
+        else:
+            d_rhok[d_idx] = d_rhok[d_idx] + dt * d_arho[d_idx]
+            d_rho[d_idx] = d_rhok[d_idx]
         d_uh[d_idx] = d_ui[d_idx]
         d_vh[d_idx] = d_vi[d_idx]
         d_x[d_idx] = d_xi[d_idx]
@@ -342,8 +356,10 @@ class VariationalScheme(Scheme):
         self.hphi = h_cut if kernel in ("K1", "K2") else self.lam   # digest A34
         self.av_a, self.av_b, self.D, self.r0, self.wall_power = av_a, av_b, D, r0, wall_power
         self.integrator, self.alpha, self.tol, self.max_iter = integrator, alpha, tol, max_iter
-        if density not in ("continuity", "summation"):
-            raise ValueError(f"VariationalScheme: density {density!r}: continuity or summation")
+        if density not in DENSITIES:
+            raise ValueError(f"VariationalScheme: density {density!r}: {', '.join(DENSITIES)}")
+        if density == "centred" and integrator != "variational":
+            raise ValueError("VariationalScheme: density 'centred' needs integrator='variational'")
         self.density = density
         if predictor not in PREDICTORS:
             raise ValueError(f"VariationalScheme: predictor {predictor!r}: {', '.join(PREDICTORS)}")
@@ -371,18 +387,22 @@ class VariationalScheme(Scheme):
     def get_equations(self):
         f, w = self.fluids, self.walls
         summation = self.density == "summation"
+        centred = self.density == "centred"
 
         def eos():
             return Group([TaitEOS(d, None, rho0=self.rho0, c0=self.c0, gamma=self.gamma) for d in f])
 
-        def density():
-            cls = GaussianSummationDensity if summation else GaussianContinuityDensity
-            return Group([cls(d, f, **self._kw()) for d in f])
+        def density(weight=1.0):
+            if summation:
+                return Group([GaussianSummationDensity(d, f, **self._kw()) for d in f])
+            return Group([GaussianContinuityDensity(d, f, weight=weight, **self._kw()) for d in f])
 
         # set 0 at xbar(q_{k-1}, q_k): the continuity density rho_{k-1,k} is the stored one,
-        # the summation density is recomputed there (eq. 20)
-        old = ([density()] if summation else []) + [eos(), Group([e for d in f for e in self._forces(d)])]
-        new = [density(), eos(), Group([e for d in f for e in self._forces(d)])]
+        # the summation density is recomputed there (eq. 20), the centred one interpolated
+        a = self.alpha
+        old = ([density(-(1.0 - a))] if summation or centred else []) + [
+            eos(), Group([e for d in f for e in self._forces(d)])]
+        new = [density(a if centred else 1.0), eos(), Group([e for d in f for e in self._forces(d)])]
         walls = [ZeroAcceleration(d) for d in f]
         if w:
             walls += [LennardJonesWallForce(d, w, D=self.D, r0=self.r0, power=self.wall_power) for d in f]
@@ -390,7 +410,8 @@ class VariationalScheme(Scheme):
 
     def get_integrator(self):
         step = VariationalStep(alpha=self.alpha if self.integrator == "variational" else 1.0,
-                               gx=self.gx, gy=self.gy, predictor=PREDICTORS[self.predictor])
+                               gx=self.gx, gy=self.gy, predictor=PREDICTORS[self.predictor],
+                               centred=int(self.density == "centred"))
         steppers = {name: step for name in self.fluids}
         if self.integrator == "explicit":
             return ExplicitLeapfrog(**steppers)
