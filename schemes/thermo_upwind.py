@@ -442,6 +442,12 @@ class ThermoUpwindScheme(Scheme):
         thermal = [b for b in self.bodies if self._has_flags(b, "tfix") and self.form == "E"]
         return ThermoRK2(self.bodies, self.loads, self.velocity, self.temperature, thermal, **steppers)
 
+    def output_properties(self, pa):
+        """The output properties, and the per-particle step limit ``dt_cfl`` that the solver
+        reads when the step follows eq. 78."""
+        props = super().output_properties(pa)
+        return props + ["dt_cfl"] if self.adaptive_dt and pa.name in self.bodies else props
+
     def max_wave_speed(self):
         """c_p,max at the bodies' current temperatures."""
         return max(float(np.max(self.material.wave_speeds(pa.theta))) for pa in self.arrays.values())

@@ -9,6 +9,7 @@ Counting rule used throughout: an interval of length ``L`` holds ``cells(L, dx) 
 floor(L/dx + 1e-9)`` whole cells of width ``dx`` (the 1e-9 absorbs round-off, so
 ``L = 10*dx`` gives 10); a leftover strip thinner than ``dx`` stays empty.
 """
+import itertools
 import math
 
 import numpy as np
@@ -136,6 +137,45 @@ def l_shape(xmin, xmax, ymin, ymax, wx, wy, dx):
     """
     return remove_inside(square_lattice(dx, xmin, xmax, ymin, ymax),
                          lambda x, y: (x > xmin + wx) & (y > ymin + wy))
+
+
+# ------------------------------------------------------------------ vertex lattices
+def vertex_lattice(dx, *bounds):
+    """Vertices lo + i dx, i = 0..cells(hi - lo, dx), of a box given as (lo, hi) pairs (any
+    dimension): particles sit on the box's faces, unlike the cell-centred lattices."""
+    axes = [lo + np.arange(cells(hi - lo, dx) + 1) * dx for lo, hi in zip(bounds[::2], bounds[1::2])]
+    return _grid(*axes)
+
+
+def vertex_fractions(points, inside, dx):
+    """Fraction of each vertex's cell (side dx, centred on it) inside a body: the share of
+    its 2^dim sub-cells whose centres satisfy ``inside`` (exact for unions of boxes aligned
+    with the lattice: 1 inside, 1/2 on a face, 1/4 on an edge, 1/8 at a corner, 3/4 on a
+    re-entrant edge).  In 2D with a face's in-plane coordinates it gives tributary areas."""
+    points = [np.asarray(p, dtype=float) for p in points]
+    frac = np.zeros(points[0].size)
+    for signs in itertools.product((-0.25, 0.25), repeat=len(points)):
+        frac += np.asarray(inside(*[p + s * dx for p, s in zip(points, signs)]), dtype=float)
+    return frac / 2 ** len(points)
+
+
+def l_block(dx, height=10.0, length=6.0, width=3.0, depth=3.0):
+    """Vertices of the 3D L-shaped block [0, width] x [0, height] x [0, depth] U
+    [width, length] x [0, width] x [0, depth] (the L-block of Ghavamian et al. 2021 sec. 7.2
+    with the defaults) and their volumes dx^3 vertex_fractions: (x, y, z, V)."""
+    x, y, z = vertex_lattice(dx, 0.0, length, 0.0, height, 0.0, depth)
+    inside = inside_l_block(height, length, width, depth)
+    keep = inside(x, y, z)
+    x, y, z = x[keep], y[keep], z[keep]
+    return x, y, z, dx ** 3 * vertex_fractions((x, y, z), inside, dx)
+
+
+def inside_l_block(height=10.0, length=6.0, width=3.0, depth=3.0):
+    """Shape function (x, y, z) -> mask of the closed L-block of :func:`l_block`."""
+    tol = 1e-9 * max(height, length)
+    return lambda x, y, z: ((x >= -tol) & (y >= -tol) & (z >= -tol) & (z <= depth + tol)
+                            & (((x <= width + tol) & (y <= height + tol))
+                               | ((x <= length + tol) & (y <= width + tol))))
 
 
 # ------------------------------------------------------------------ masks

@@ -116,6 +116,18 @@ def test_l_shape_count():
     assert not np.any((x > 0.3) & (y > 0.4))
 
 
+def test_l_block_vertex_lattice_volumes():
+    """Vertices of the 3D L-block (Ghavamian et al. 2021 sec. 7.2) with cell-fraction
+    volumes: they add up to the block's 117 m^3; 1/8 at a corner, 3/4 on the re-entrant edge."""
+    x, y, z, V = g.l_block(0.5)
+    assert x.size == 13 * 21 * 7 - 6 * 14 * 7 and V.sum() == pytest.approx(117.0, rel=1e-14)
+    at = lambda X, Y, Z: V[(x == X) & (y == Y) & (z == Z)][0]  # noqa: E731
+    assert at(0, 0, 0) == 0.125 * 0.125 and at(0, 5, 1) == 0.0625 and at(3, 3, 0) == 0.75 * 0.125 / 2
+    assert at(3, 3, 1) == 0.75 * 0.125 and at(6, 1, 1) == 0.0625 and not np.any((x > 3) & (y > 3))
+    frac = g.vertex_fractions(g.vertex_lattice(0.5, 0, 1, 0, 1), g.inside_rectangle(0, 1, 0, 1), 0.5)
+    assert sorted(set(frac)) == [0.25, 0.5, 1.0] and frac.sum() * 0.25 == pytest.approx(1.0)
+
+
 def test_masks():
     pts = g.square_lattice(0.1, 0, 1, 0, 1)
     hole = g.inside_disk(0.5, 0.5, 0.2)
