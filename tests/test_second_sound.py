@@ -81,6 +81,25 @@ def test_wave_with_walls_converges(coarse, tmp_path):
     assert e32 < 0.5 * e16, (e16, e32)
 
 
+def test_precision_and_stress_studies_run(tmp_path):
+    """`sphgen precision second_sound` (entropy error against run time) and `sphgen stress
+    second_sound` (perturbed lattice, dt factors up to the documented limit h/c1 = M/2 at M = 10)."""
+    from sphgen.studies import main
+    d = tmp_path / "prec"
+    assert main("precision", ["second_sound", "--N", "12", "24", "--M", "10", "--threads", "1",
+                              "--disable-output", "-d", str(d)]) == 0
+    runs = json.load(open(d / "precision.json"))["runs"]
+    e = [r["results"]["entropy_error"] for r in runs]
+    assert [r["info"]["n_particles"] for r in runs] == [18 ** 2, 30 ** 2] and e[1] < 0.6 * e[0], e
+    s = tmp_path / "stress"
+    assert main("stress", ["second_sound", "--runs", "1", "--N", "12", "--M", "10", "--threads", "1",
+                           "--disable-output", "--dt-factor", "1", "5", "--stable-factor", "5",
+                           "-d", str(s)]) == 0
+    rows = json.load(open(s / "stress.json"))["runs"]
+    assert len(rows) == 2 and all(r["exit"] == 0 for r in rows)
+    assert all(r["results"]["energy_error"] < 1e-2 for r in rows)
+
+
 @pytest.mark.parametrize("args", [["--N", "4"], ["--M", "0"], ["--A", "-1"], ["--beta", "-1"],
                                   ["--perturb", "0.7"], ["--boundary", "open"]])
 def test_bad_options_are_one_line_errors(args, tmp_path):
