@@ -91,6 +91,9 @@ class SecondSound(Application):
                            help="entropy diffusion beta of eq. 3.38 (default %(default)s)")
         group.add_argument("--mu", type=float, default=0.0,
                            help="normal viscosity mu of eq. 3.38 [Pa s] (default %(default)s)")
+        group.add_argument("--renormalise", action="store_true",
+                           help="divide the thermal operators by the first-moment normalisation of "
+                           "each particle's support (not in the thesis; docs/superfluid.md)")
         group.add_argument("--samples", type=int, default=SAMPLES,
                            help="history rows per period (default %(default)s)")
         group.add_argument("--boundary", choices=("walls", "periodic"), default="walls",
@@ -158,7 +161,7 @@ class SecondSound(Application):
     def create_scheme(self):
         o = self.options
         return SuperfluidScheme(arrays=("helium",), dim=2, model=MODEL, h=self.h, beta=o.beta, mu=o.mu,
-                                dt=self.dt)
+                                dt=self.dt, renormalise=o.renormalise)
 
     # ------------------------------------------------------------ time series
     def post_step(self, solver):
