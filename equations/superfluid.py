@@ -46,17 +46,20 @@ FLUID, ADIABATIC, COOLER = 0, 1, 2
 
 
 class SuperfluidState(Equation):
-    """rho_n/rho, v_ns, v_n, p, T and J/rho^2 of each particle (Kincl 2023, eqs. 3.1-3.3, 3.25, 3.27, 3.30)."""
+    """rho_n/rho, v_ns, v_n, p, T and J/rho^2 of each particle (Kincl 2023, eqs. 3.1-3.3, 3.25, 3.27, 3.30).
 
-    switches = ("dim",)
+    ``renormalise``: J/rho^2 is divided by the particle's thermal normalisation ``lam``
+    (:class:`ThermalNormalisation`)."""
+
+    switches = ("dim", "renormalise")
 
     def __init__(self, dest, sources=None, dim=2, T0=1.0, rho0=1.0, s0=1.0, rhon0=0.5, c1=1.0,
-                 cv=1.0, gamma=0.0):
+                 cv=1.0, gamma=0.0, renormalise=0):
         super().__init__(dest, None, dim=dim, T0=T0, rho0=rho0, s0=s0, rhon0=rhon0, c1=c1, cv=cv,
-                         gamma=gamma)
+                         gamma=gamma, renormalise=renormalise)
 
     def post_loop(self, d_idx, d_rho, d_s, d_u, d_v, d_w, d_us, d_vs, d_ws, d_rhon, d_uns, d_vns,
-                  d_wns, d_un, d_vn, d_wn, d_p, d_T, d_jx, d_jy, d_jz):
+                  d_wns, d_un, d_vn, d_wn, d_p, d_T, d_jx, d_jy, d_jz, d_lam):
         rhon = normal_fraction(d_s[d_idx], self.s0, self.rhon0, self.gamma)
         rhos = 1.0 - rhon
         irn = 1.0 / rhon
@@ -76,6 +79,8 @@ class SuperfluidState(Equation):
         d_p[d_idx] = linear_pressure(d_rho[d_idx], self.rho0, self.c1)
         d_T[d_idx] = linear_temperature(d_s[d_idx], vns2, self.T0, self.s0, self.cv, self.gamma)
         f = rhos * d_s[d_idx] / d_rho[d_idx]
+        if self.renormalise:
+            f = f / d_lam[d_idx]
         d_jx[d_idx] = f * uns
         d_jy[d_idx] = f * vns
         if self.dim > 2:
@@ -223,25 +228,59 @@ class CounterflowCoupling(Equation):
 
 
 class Thermomechanical(Equation):
-    """dv_s,a/dt += s_a grad_a{T} = -s_a/rho_a sum_b m_b (T_a - T_b) grad W_ab (Kincl 2023, eq. 3.34)."""
+    """dv_s,a/dt += s_a grad_a{T} = -s_a/rho_a sum_b m_b (T_a - T_b) grad W_ab (Kincl 2023, eq. 3.34).
 
-    switches = ("dim", "masked")
+    ``renormalise``: the gradient is divided by ``lam_a`` (:class:`ThermalNormalisation`)."""
 
-    def __init__(self, dest, sources, dim=2, masked=0):
-        super().__init__(dest, sources, dim=dim, masked=masked)
+    switches = ("dim", "masked", "renormalise")
 
-    def loop(self, d_idx, d_aus, d_avs, d_aws, d_s, d_rho, d_T, d_ptype, s_idx, s_m, s_T, s_ptype,
-             DWIJ):
+    def __init__(self, dest, sources, dim=2, masked=0, renormalise=0):
+        super().__init__(dest, sources, dim=dim, masked=masked, renormalise=renormalise)
+
+    def loop(self, d_idx, d_aus, d_avs, d_aws, d_s, d_rho, d_T, d_lam, d_ptype, s_idx, s_m, s_T,
+             s_ptype, DWIJ):
         thermal = 1.0
         if self.masked:
             if d_ptype[d_idx] == 1 or s_ptype[s_idx] == 1:
                 thermal = 0.0
         if thermal > 0.0:
             f = -s_m[s_idx] * d_s[d_idx] * (d_T[d_idx] - s_T[s_idx]) / d_rho[d_idx]
+            if self.renormalise:
+                f = f / d_lam[d_idx]
             d_aus[d_idx] += f * DWIJ[0]
             d_avs[d_idx] += f * DWIJ[1]
             if self.dim > 2:
                 d_aws[d_idx] += f * DWIJ[2]
+
+
+class ThermalNormalisation(Equation):
+    """lam_a = -1/d sum_b (m_b/rho_b) x_ab . grad W_ab over the pairs that carry heat (1 in a
+    full, fine support): the scalar first-moment normalisation of the thermal operators
+    (not in Kincl 2023; docs/superfluid.md).  Dividing grad T by lam_a and J by lam in the
+    entropy flux keeps the pair of operators dual, so Theorem 9 holds."""
+
+    switches = ("dim", "masked")
+
+    def __init__(self, dest, sources, dim=2, masked=0):
+        super().__init__(dest, sources, dim=dim, masked=masked)
+
+    def initialize(self, d_idx, d_lam):
+        d_lam[d_idx] = 0.0
+
+    def loop(self, d_idx, d_lam, d_ptype, s_idx, s_m, s_rho, s_ptype, XIJ, DWIJ):
+        thermal = 1.0
+        if self.masked:
+            if d_ptype[d_idx] == 1 or s_ptype[s_idx] == 1:
+                thermal = 0.0
+        if thermal > 0.0:
+            xd = XIJ[0] * DWIJ[0] + XIJ[1] * DWIJ[1]
+            if self.dim > 2:
+                xd += XIJ[2] * DWIJ[2]
+            d_lam[d_idx] += -s_m[s_idx] / s_rho[s_idx] * xd / self.dim
+
+    def post_loop(self, d_idx, d_lam):
+        if d_lam[d_idx] < 0.1:   # an isolated particle (or a wall): no renormalisation
+            d_lam[d_idx] = 1.0
 
 
 class NormalViscosity(Equation):

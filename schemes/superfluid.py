@@ -26,12 +26,13 @@ from sphgen.scheme import Bound, Scheme
 from ..equations.basic import SummationDensityWithConstant
 from ..equations.superfluid import (ADIABATIC, COOLER, FLUID, CounterflowCoupling, CounterflowStress,
                                     EntropyFlux, EntropyProduction, NormalViscosity, SuperfluidGravity,
-                                    SuperfluidPressure, SuperfluidState, Thermomechanical)
+                                    SuperfluidPressure, SuperfluidState, ThermalNormalisation,
+                                    Thermomechanical)
 from ..equations.superfluid_energy import HELIUM_1_9K
 
 STATE_PROPS = ("s", "us", "vs", "ws", "rhon", "uns", "vns", "wns", "un", "vn", "wn", "p", "T",
                "jx", "jy", "jz", "sdot", "zeta", "au", "av", "aw", "aus", "avs", "aws", "crho",
-               "ustart", "vstart", "wstart", "usstart", "vsstart", "wsstart", "sstart", "snew")
+               "ustart", "vstart", "wstart", "usstart", "vsstart", "wsstart", "sstart", "snew", "lam")
 INPUT_PROPS = ("s", "u", "v", "w", "us", "vs", "ws", "crho")   # given, or at rest at s0 with C = 0
 
 
@@ -223,7 +224,7 @@ class SuperfluidScheme(Scheme):
 
     def __init__(self, arrays=("helium",), dim=2, model=HELIUM_1_9K, h=None, beta=0.0, mu=0.0, eta2=None,
                  gravity=(0.0, 0.0, 0.0), kernel="wendland", dt=None, cfl=0.4, calibrate_density=True,
-                 reversible=False, rtol=1e-14, max_iterations=30):
+                 reversible=False, rtol=1e-14, max_iterations=30, renormalise=False):
         if dim not in (2, 3):
             raise InputError(f"SuperfluidScheme: dim must be 2 or 3, got {dim!r}")
         if h is None or not h > 0:
@@ -241,6 +242,7 @@ class SuperfluidScheme(Scheme):
         self.cfl, self.dt = float(cfl), dt
         self.calibrate = bool(calibrate_density)
         self.reversible, self.rtol, self.max_iterations = bool(reversible), float(rtol), int(max_iterations)
+        self.renormalise = int(bool(renormalise))
         self.masked = 0
         # the model is weakly compressible: a particle at the first-sound speed has blown up
         self.speed_limit = model.c1
@@ -279,11 +281,14 @@ class SuperfluidScheme(Scheme):
 
     # ------------------------------------------------------------ equations
     def _density_state(self):
-        a, m = self.arrays, self.model.parameters()
-        eqs = []
-        for d in a:
-            eqs += [SummationDensityWithConstant(d, a), SuperfluidState(d, dim=self.dim, **m)]
-        return eqs
+        """[density + state] or, renormalised, [density], [thermal normalisation + state]."""
+        a, m, rn = self.arrays, self.model.parameters(), self.renormalise
+        density = [SummationDensityWithConstant(d, a) for d in a]
+        state = [SuperfluidState(d, dim=self.dim, renormalise=rn, **m) for d in a]
+        if not rn:
+            return [Group([e for pair in zip(density, state) for e in pair])]
+        lam = [ThermalNormalisation(d, a, dim=self.dim, masked=self.masked) for d in a]
+        return [Group(density), Group([e for pair in zip(lam, state) for e in pair])]
 
     def _entropy_rate(self):
         a, dim, mk = self.arrays, self.dim, self.masked
@@ -298,16 +303,15 @@ class SuperfluidScheme(Scheme):
         eqs = []
         for d in a:
             eqs += [SuperfluidPressure(d, a, dim=dim), CounterflowStress(d, a, dim=dim),
-                    CounterflowCoupling(d, a, dim=dim), Thermomechanical(d, a, dim=dim, masked=mk),
+                    CounterflowCoupling(d, a, dim=dim), Thermomechanical(d, a, dim=dim, masked=mk, renormalise=self.renormalise),
                     NormalViscosity(d, a, dim=dim, mu=self.mu, eta2=self.eta2)]
             if self.gx or self.gy or self.gz:
                 eqs.append(SuperfluidGravity(d, dim=dim, gx=self.gx, gy=self.gy, gz=self.gz))
         return eqs
 
     def get_equations(self):
-        state = self._density_state()
-        return [[Group(state), Group(self._entropy_rate())],
-                [Group(state), Group(self._velocity_rates())]]
+        return [self._density_state() + [Group(self._entropy_rate())],
+                self._density_state() + [Group(self._velocity_rates())]]
 
     def get_integrator(self):
         step = SuperfluidStep(self.dim)

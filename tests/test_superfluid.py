@@ -261,6 +261,23 @@ def test_three_dimensional_rates_conserve_on_the_python_evaluator():
     assert np.abs(pa.aws).max() > 0
 
 
+@pytest.mark.parametrize("adiabatic", [0.0, 0.2])
+def test_renormalised_thermal_operators_conserve_on_the_python_evaluator(adiabatic):
+    """renormalise=True (grad T and J divided by the first-moment normalisation lam): energy,
+    sum m s and momentum are still conserved by the reversible rates (Theorem 9)."""
+    pa, dx = cloud(nx=8, adiabatic=adiabatic, seed=13)
+    sch, integ, sc = scene(pa, dx, backend="python", beta=0.0, mu=0.0, masked=adiabatic > 0,
+                           renormalise=True)
+    rates(sc)
+    lam = pa.lam[pa.ptype != ADIABATIC]
+    assert lam.min() > 0.1 and lam.max() < 1.5 and np.ptp(lam) > 0.2   # edges of the cloud < 1
+    terms = energy_rate_terms(pa, sch.kernel, 2)
+    assert relative(sum(t.sum() for t in terms), terms) < 1e-12
+    assert relative(np.sum(pa.m * pa.sdot), [pa.m * pa.sdot]) < 1e-12
+    for c in ("au", "av"):
+        assert relative(np.sum(pa.m * pa.get(c)), [pa.m * pa.get(c)]) < 1e-12
+
+
 def _methods(sc, name):
     return {m: ast.unparse(mp.fdef) for ep in sc.plan.eqplans if type(ep.eq).__name__ == name
             for m, mp in ep.methods.items()}

@@ -1,0 +1,248 @@
+"""Second-sound standing wave in He II (Kincl 2023, thesis sec. 3.5, eqs. 3.45-3.51).
+
+The square (0, L)^2, L = 1 cm, holds N x N helium particles on the cell-centred square
+lattice (spacing dr = L/N, mass rho0 dr^2), surrounded by dummy walls: ``n`` layers of
+ADIABATIC particles (v = v_s = 0, no entropy flux, diffusion or s grad T across a pair
+with a wall: adiabatic, eq. 3.45, and no-slip, eq. 3.46), n = ceil(2h/dr) so the kernel
+support is full.  At t = 0: v = v_s = 0, rho = rho0 (summation density with its constant,
+eq. 1.14) and s from eq. 3.51,
+
+    (s - s0)/s0 = A cos(pi x/L) cos(pi y/L) cos(sqrt(2) pi c2 t/L),
+
+the linear standing wave (walls at s0).  The run lasts one period, t = sqrt(2) L/c2.
+Helium at T0 = 1.9 K (:data:`~sphgen.equations.superfluid_energy.HELIUM_1_9K`), c1 = 40 m/s;
+h = ``--hdx`` dr (default 1.5); dt = 2h/(M c1) with M the temporal resolution
+(``--M``, default 50); beta = mu = 0 unless given.  The thesis prints none of these: the
+choices and their sources are in docs/superfluid.md.
+
+``post_process`` writes results.json:
+
+* ``entropy_error``: max over the sampled times of the RMS over the fluid particles of
+  (s_a - s_exact(x_a, t))/(A s0), eq. 3.51 at the particle's current position;
+* ``energy_error``: max over the sampled times of |E(t) - E(0)|/E(0), E the total energy
+  (eqs. 3.23 + 3.32) summed over all particles, walls included;
+* the entropy at (L/4, L/4) against eq. 3.51 (Shepard interpolation of the fluid), the
+  largest |rho/rho0 - 1| and the drift of sum m s;
+
+and second_sound.png (the probe against eq. 3.51, both errors over time).
+"""
+import json
+import os
+from math import cos, pi, sqrt
+
+import numpy as np
+
+from sphgen import io
+from sphgen.app import Application
+from sphgen.errors import InputError
+from sphgen.geometry import layers_for_support, perturb, square_lattice, wall_layers_box
+from sphgen.nnps import Domain
+from sphgen.particles import ParticleArray
+from sphgen.tools.probes import shepard
+
+from ..equations.superfluid import ADIABATIC, FLUID
+from ..equations.superfluid_energy import HELIUM_1_9K
+from ..schemes.superfluid import SuperfluidScheme
+
+L = 0.01
+MODEL = HELIUM_1_9K
+PERIOD = sqrt(2.0) * L / MODEL.c2
+C1_WINDOW = sqrt(2.0) * L / MODEL.c1   # the end time of the authors' code (0.47 periods)
+SAMPLES = 400   # history rows per period (the errors are maxima over these times)
+
+
+def exact_entropy(x, y, t, A, model=MODEL):
+    """s of the linear standing wave, eq. 3.51."""
+    omega = sqrt(2.0) * pi * model.c2 / L
+    return model.s0 * (1.0 + A * np.cos(pi * x / L) * np.cos(pi * y / L) * cos(omega * t))
+
+
+def entropy_error(x, y, s, t, A, model=MODEL):
+    """RMS over particles of (s - s_exact)/(A s0)."""
+    d = (s - exact_entropy(x, y, t, A, model)) / (A * model.s0)
+    return float(np.sqrt(np.mean(d * d)))
+
+
+def loglog_slope(x, y):
+    """Least-squares slope of log y against log x."""
+    return float(np.polyfit(np.log(x), np.log(y), 1)[0])
+
+
+class SecondSound(Application):
+    """Second-sound standing wave in a 1 cm square of He II (Kincl 2023, sec. 3.5)."""
+
+    tf = PERIOD
+    pfreq = 100000
+    dim = 2
+    history_columns = ("t", "entropy_error", "energy", "kinetic", "compression", "heat", "entropy",
+                       "s_probe", "s_probe_exact", "max_density_error")
+    error_key = "entropy_error"   # what `sphgen precision` plots against run time
+    diagnostics = ("linear_momentum", "density_range")
+    diagnostics_every = 50
+
+    def add_user_options(self, group):
+        group.add_argument("--N", type=int, default=100, help="N x N fluid particles (default %(default)s)")
+        group.add_argument("--M", type=float, default=50.0,
+                           help="temporal resolution: dt = 2h/(M c1) (default %(default)s)")
+        group.add_argument("--A", type=float, default=0.01,
+                           help="amplitude (s - s0)/s0 of eq. 3.51 (default %(default)s)")
+        group.add_argument("--hdx", type=float, default=1.5, help="h / dr (default %(default)s)")
+        group.add_argument("--beta", type=float, default=0.0,
+                           help="entropy diffusion beta of eq. 3.38 (default %(default)s)")
+        group.add_argument("--mu", type=float, default=0.0,
+                           help="normal viscosity mu of eq. 3.38 [Pa s] (default %(default)s)")
+        group.add_argument("--renormalise", action="store_true",
+                           help="divide the thermal operators by the first-moment normalisation of "
+                           "each particle's support (not in the thesis; docs/superfluid.md)")
+        group.add_argument("--samples", type=int, default=SAMPLES,
+                           help="history rows per period (default %(default)s)")
+        group.add_argument("--boundary", choices=("walls", "periodic"), default="walls",
+                           help="walls: the thesis' dummy ADIABATIC walls around (0, L)^2; periodic: "
+                           "the same wave in the periodic box (0, 2L)^2, 2N x 2N particles, no walls "
+                           "(isolates the interior error) (default %(default)s)")
+        group.add_argument("--perturb", type=float, default=0.0,
+                           help="random displacement of the fluid particles in units of dr (default 0)")
+        group.add_argument("--seed", type=int, default=1, help="seed of the perturbation (default 1)")
+
+    def consume_user_options(self, o):
+        if o.N < 8:
+            raise InputError(f"--N must be at least 8, got {o.N}")
+        for name in ("M", "A", "hdx"):
+            v = getattr(o, name)
+            if not (np.isfinite(v) and v > 0):
+                raise InputError(f"--{name} must be a positive finite number, got {v}")
+        for name in ("beta", "mu"):
+            v = getattr(o, name)
+            if not (np.isfinite(v) and v >= 0):
+                raise InputError(f"--{name} must be a non-negative finite number, got {v}")
+        if not (np.isfinite(o.perturb) and 0 <= o.perturb < 0.5):
+            raise InputError(f"--perturb must be in [0, 0.5), got {o.perturb}")
+        if o.samples < 2:
+            raise InputError(f"--samples must be at least 2, got {o.samples}")
+        self.N, self.M, self.A = o.N, o.M, o.A
+        self.dr = L / o.N
+        self.h = o.hdx * self.dr
+        self.dt = 2.0 * self.h / (o.M * MODEL.c1)
+        self.every = max(1, int(round(PERIOD / self.dt / o.samples)))
+        self.n_layers = layers_for_support(2.0, o.hdx)
+        self.side = L if o.boundary == "walls" else 2.0 * L
+        self.history = []
+
+    def create_domain(self):
+        if self.options.boundary == "periodic":
+            return Domain(0.0, self.side, 0.0, self.side, periodic_in_x=True, periodic_in_y=True)
+        return None
+
+    def create_particles(self):
+        dr, side = self.dr, self.side
+        x, y = square_lattice(dr, 0.0, side, 0.0, side)
+        if self.options.perturb > 0:
+            x, y = perturb((x, y), self.options.perturb * dr, seed=self.options.seed)
+            if self.options.boundary == "periodic":
+                x, y = np.mod(x, side), np.mod(y, side)
+        if self.options.boundary == "walls":
+            wx, wy, _, _ = wall_layers_box(0.0, L, 0.0, L, dr, self.n_layers, open_top=False)
+        else:
+            wx = wy = np.empty(0)
+        nf, nw = x.size, wx.size
+        s = np.concatenate([exact_entropy(x, y, 0.0, self.A), np.full(nw, MODEL.s0)])
+        n = nf + nw
+        pa = ParticleArray("helium", x=np.concatenate([x, wx]), y=np.concatenate([y, wy]), s=s,
+                           m=np.full(n, MODEL.rho0 * dr * dr), rho=np.full(n, MODEL.rho0),
+                           h=np.full(n, self.h))
+        pa.add_property("ptype", dtype="int",
+                        data=np.concatenate([np.full(nf, FLUID), np.full(nw, ADIABATIC)]).astype(np.int32))
+        # the history row of t = 0 as created: rho = rho0 (calibrated), v = v_s = 0
+        heat = float(np.sum(pa.m * MODEL.heat_energy(s)))
+        probe = float(exact_entropy(np.array([L / 4]), np.array([L / 4]), 0.0, self.A)[0])
+        self.initial = [0.0, 0.0, heat, 0.0, 0.0, heat, float(np.sum(pa.m * s)), probe, probe, 0.0]
+        return [pa]
+
+    def create_scheme(self):
+        o = self.options
+        return SuperfluidScheme(arrays=("helium",), dim=2, model=MODEL, h=self.h, beta=o.beta, mu=o.mu,
+                                dt=self.dt, renormalise=o.renormalise)
+
+    # ------------------------------------------------------------ time series
+    def post_step(self, solver):
+        if not self.history:
+            self.record(0.0, self.initial)
+        if solver.step % self.every == 0 or solver.t >= solver.tf - 1e-12 * solver.tf:
+            self.record(solver.t)
+
+    def record(self, t, row=None):
+        if row is None:
+            row = self.history_row(self.scene.by_name["helium"], self.scheme, t, self.A)
+        self.history.append(row)
+
+    @staticmethod
+    def history_row(pa, scheme, t, A):
+        fluid = np.asarray(pa.ptype) == FLUID
+        x, y, s = pa.x[fluid], pa.y[fluid], pa.s[fluid]
+        e = scheme.energies([pa])
+        probe = shepard((np.array([L / 4]), np.array([L / 4])), x, y, pa.h[fluid], pa.m[fluid],
+                        pa.rho[fluid], s, scheme.kernel)
+        return [t, entropy_error(x, y, s, t, A), e["total"], e["kinetic"], e["compression"], e["heat"],
+                e["entropy"], float(probe[0]),
+                float(exact_entropy(np.array([L / 4]), np.array([L / 4]), t, A)[0]),
+                float(np.abs(pa.rho / MODEL.rho0 - 1.0).max())]
+
+    def history_meta(self):
+        return {"N": self.N, "M": self.M, "A": self.A, "boundary": self.options.boundary, "h": self.h, "dt": self.dt, "period": PERIOD}
+
+    # ------------------------------------------------------------ results
+    def post_process(self, outdir):
+        """results.json and second_sound.png from history.json."""
+        with open(os.path.join(outdir, "history.json")) as f:
+            hist = json.load(f)
+        if not hist["rows"]:
+            raise InputError("second_sound: no time step was taken, nothing to post-process")
+        rows = np.array(hist["rows"])
+        cols = {c: rows[:, i] for i, c in enumerate(hist["columns"])}
+        E, S = cols["energy"], cols["entropy"]
+        energy_dev = np.abs(E - E[0]) / abs(E[0])
+        results = {"t": float(cols["t"][-1]), "period": PERIOD, "N": hist["N"], "M": hist["M"],
+                   "A": hist["A"], "boundary": hist.get("boundary", "walls"), "h": hist["h"], "dt": hist["dt"],
+                   "entropy_error": float(cols["entropy_error"].max()),
+                   "entropy_error_final": float(cols["entropy_error"][-1]),
+                   # the window of the authors' code, t <= sqrt(2) L/c1 (docs/superfluid.md)
+                   "entropy_error_c1_window": float(cols["entropy_error"][cols["t"] <= C1_WINDOW * (1 + 1e-12)].max()),
+                   "energy_error": float(energy_dev.max()),
+                   "energy_error_final": float(energy_dev[-1]),
+                   "energy_initial": float(E[0]),
+                   "total_entropy_drift": float(np.abs(S - S[0]).max() / abs(S[0])),
+                   "probe_error": float(np.abs(cols["s_probe"] - cols["s_probe_exact"]).max()
+                                        / (hist["A"] * MODEL.s0)),
+                   "max_density_error": float(cols["max_density_error"].max()),
+                   "samples": int(rows.shape[0])}
+        io.write_json(os.path.join(outdir, "results.json"), results)
+        self.plot(outdir, cols, energy_dev, hist)
+        print(f"second_sound: N={hist['N']} M={hist['M']:g} A={hist['A']:g}  t={results['t']:.4g} s "
+              f"(period {PERIOD:.4g} s)\n  entropy error (max RMS / (A s0)) = {results['entropy_error']:.4g}"
+              f"   energy error (max |E - E0|/E0) = {results['energy_error']:.3g}\n"
+              f"results: {os.path.join(outdir, 'results.json')}\n"
+              f"figure:  {os.path.join(outdir, 'second_sound.png')}")
+        return results
+
+    @staticmethod
+    def plot(outdir, cols, energy_dev, hist):
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        t = cols["t"] * 1e3
+        fig, (a, b, c) = plt.subplots(1, 3, figsize=(14, 4))
+        a.plot(t, cols["s_probe_exact"] - MODEL.s0, "k-", label="eq. 3.51")
+        a.plot(t, cols["s_probe"] - MODEL.s0, "r.", ms=3, label="sphgen")
+        a.set_xlabel("t [ms]")
+        a.set_ylabel("s - s0 at (L/4, L/4) [J/(kg K)]")
+        a.legend()
+        b.plot(t, cols["entropy_error"], "b-")
+        b.set_xlabel("t [ms]")
+        b.set_ylabel("RMS (s - s_exact)/(A s0)")
+        c.semilogy(t[1:], np.maximum(energy_dev[1:], 1e-18), "g-")
+        c.set_xlabel("t [ms]")
+        c.set_ylabel("|E - E0| / E0")
+        fig.suptitle(f"second sound, N = {hist['N']}, M = {hist['M']:g}, A = {hist['A']:g}")
+        fig.tight_layout()
+        fig.savefig(os.path.join(outdir, "second_sound.png"), dpi=100)
+        plt.close(fig)
