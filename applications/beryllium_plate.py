@@ -12,7 +12,8 @@ lattice point), h = 1.5 dr, dt from eq. 26, tensile penalty c_p = ``--cp-factor`
 
 ``results.json``: the largest relative drift of the total energy (kinetic + bulk + shear +
 penalty, eqs. 13, 15, 19) over the run, the oscillation period of the centre point y_c(t)
-(its zero crossings) beside the plane-strain Euler-Bernoulli period and 2 pi/omega, and
+(its zero crossings) beside the plane-strain Euler-Bernoulli period, 2 pi/omega and the
+linear plane-strain continuum period (finite elements, ``finite_element_period``), and
 the tear indicators (``void_fraction``: particles whose summation density fell below
 0.9 rho0; ``clump_fraction``: particles with a neighbour closer than dr/2; both zero for
 an elastic plate, whose strains stay below 1%).  Plots: centre.png, energy.png,
@@ -36,6 +37,9 @@ L, W = 0.06, 0.01
 RHO0, C0 = 1850.0, 9046.59
 AMP, OMEGA, ALPHA, A1, A2 = 4.3369e-5, 2.3597e5, 78.834, 56.6368, 57.6455
 HDR = 1.5
+PERIOD_CONTINUUM = 2.786e-5
+"""The linear plane-strain continuum period: finite_element_period at 60 x 10 and 96 x 16
+elements (2.7782e-5, 2.7830e-5 s) extrapolated as (size)^2 (docs/shtc.md)."""
 VOID_RHO = 0.9        # rho/rho0 below this: a particle that lost a tenth of its neighbourhood
 CLUMP_DR = 0.5        # nearest neighbour closer than this times dr: particles clumping
 
@@ -68,6 +72,41 @@ def euler_bernoulli_period(c0=C0, cs=C0, length=L, width=W, beta_l=4.730040745):
     Ep = E / (1.0 - nu * nu)                     # plane strain
     omega = beta_l ** 2 / length ** 2 * math.sqrt(Ep * width ** 2 / 12.0)
     return 2.0 * math.pi / omega
+
+
+def finite_element_period(nx, ny, c0=C0, cs=C0, length=L, width=W):
+    """First bending period of the free plane-strain plate of the linearised SHTC material by
+    bilinear finite elements (nx x ny elements, consistent mass, 2x2 Gauss; dense numpy
+    eigenproblem, so keep 2 (nx+1)(ny+1) below a few thousand).  Full integration makes the
+    elements too stiff in bending: the period converges from below, as (size/W)^2."""
+    K, mu = c0 ** 2, cs ** 2                     # per unit density
+    lam = K - 2.0 * mu / 3.0
+    D = np.array([[lam + 2 * mu, lam, 0.0], [lam, lam + 2 * mu, 0.0], [0.0, 0.0, mu]])
+    hx, hy = length / nx, width / ny
+    xn, yn = np.array([-1, 1, 1, -1]), np.array([-1, -1, 1, 1])
+    ke, me = np.zeros((8, 8)), np.zeros((8, 8))
+    for xi in (-1 / math.sqrt(3), 1 / math.sqrt(3)):
+        for eta in (-1 / math.sqrt(3), 1 / math.sqrt(3)):
+            N = 0.25 * (1 + xi * xn) * (1 + eta * yn)
+            B = np.zeros((3, 8))
+            B[0, 0::2] = B[2, 1::2] = 0.5 * xn * (1 + eta * yn) / hx
+            B[1, 1::2] = B[2, 0::2] = 0.5 * yn * (1 + xi * xn) / hy
+            Nm = np.zeros((2, 8))
+            Nm[0, 0::2] = Nm[1, 1::2] = N
+            ke += B.T @ D @ B * hx * hy / 4
+            me += Nm.T @ Nm * hx * hy / 4
+    n = 2 * (nx + 1) * (ny + 1)
+    Kg, Mg = np.zeros((n, n)), np.zeros((n, n))
+    for i in range(nx):
+        for j in range(ny):
+            nodes = [j * (nx + 1) + i, j * (nx + 1) + i + 1, (j + 1) * (nx + 1) + i + 1, (j + 1) * (nx + 1) + i]
+            dofs = np.ravel([[2 * k, 2 * k + 1] for k in nodes])
+            Kg[np.ix_(dofs, dofs)] += ke
+            Mg[np.ix_(dofs, dofs)] += me
+    Li = np.linalg.inv(np.linalg.cholesky(Mg))
+    A = Li @ Kg @ Li.T
+    ev = np.sort(np.abs(np.linalg.eigvalsh(0.5 * (A + A.T))))
+    return 2.0 * math.pi / math.sqrt(ev[3])      # three rigid-body modes first
 
 
 def zero_crossings(t, y):
@@ -199,6 +238,8 @@ class BerylliumPlate(Application):
             "period_euler_bernoulli": t_eb, "period_initial_omega": t_omega,
             "period_error_euler_bernoulli": None if period is None else period / t_eb - 1.0,
             "period_error_initial_omega": None if period is None else period / t_omega - 1.0,
+            "period_continuum": PERIOD_CONTINUUM,
+            "period_error_continuum": None if period is None else period / PERIOD_CONTINUUM - 1.0,
             "centre_max": float(yc.max()), "t_centre_max": float(t[np.argmax(yc)]),
             "void_fraction": void, "clump_fraction": clump, "torn": bool(max(void, clump) > 0.01),
             "rho_min": float(np.min(state["rho"]) / hist["rho0"]),
@@ -207,7 +248,7 @@ class BerylliumPlate(Application):
         self.plot(outdir, t, yc, rows[:, 2:], state, hist)
         p = "n/a" if period is None else f"{period:.4g} s ({how})"
         print(f"beryllium_plate: t={t[-1]:.4g}  energy drift {results['energy_drift']:.3g}  period {p} "
-              f"(Euler-Bernoulli {t_eb:.4g}, 2pi/omega {t_omega:.4g})  void {void:.3g}  clump {clump:.3g}\n"
+              f"(Euler-Bernoulli {t_eb:.4g}, 2pi/omega {t_omega:.4g}, continuum {PERIOD_CONTINUUM:.4g})  void {void:.3g}  clump {clump:.3g}\n"
               f"results: {os.path.join(outdir, 'results.json')}")
         return results
 

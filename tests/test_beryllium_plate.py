@@ -11,8 +11,9 @@ import numpy as np
 import pytest
 
 from sphgen.app import load_application
-from sphgen.applications.beryllium_plate import (OMEGA, euler_bernoulli_period, isometric_lattice,
-                                                 measured_period, zero_crossings)
+from sphgen.applications.beryllium_plate import (OMEGA, PERIOD_CONTINUUM, euler_bernoulli_period,
+                                                 finite_element_period, isometric_lattice, measured_period,
+                                                 zero_crossings)
 
 
 def run_plate(out, *args):
@@ -37,6 +38,10 @@ def test_euler_bernoulli_period_and_lattice():
     omega = 4.730040745 ** 2 / 0.06 ** 2 * math.sqrt(Ep * 0.01 ** 2 / 12)
     assert euler_bernoulli_period() == pytest.approx(2 * math.pi / omega, rel=1e-12)
     assert euler_bernoulli_period() == pytest.approx(2.561e-5, rel=1e-3)
+    # the short plate (L/W = 6) bends slower than Euler-Bernoulli: shear and rotary inertia
+    # (coarse elements are too stiff, so this is a lower bound of the continuum period)
+    t_fe = finite_element_period(30, 5)
+    assert 1.07 * euler_bernoulli_period() < t_fe < PERIOD_CONTINUUM
     x, y = isometric_lattice(0.01 / 40, 0.06, 0.01)
     assert np.min(x * x + y * y) == 0.0          # the centre is a material point
     assert abs(x.size - 0.06 * 0.01 / (0.01 / 40) ** 2) < 0.02 * 9600
@@ -66,12 +71,21 @@ def test_without_the_penalty_the_plate_tears(coarse):
 
 
 @pytest.mark.slow
+def test_continuum_period_by_extrapolated_finite_elements():
+    t60, t96 = finite_element_period(60, 10), finite_element_period(96, 16)
+    h60, h96 = 1 / 60 ** 2, 1 / 96 ** 2
+    assert t96 + (t96 - t60) * h96 / (h60 - h96) == pytest.approx(PERIOD_CONTINUUM, rel=5e-4)
+
+
+@pytest.mark.slow
 def test_one_period_at_20_across(tmp_path):
-    """The paper's checks at half its resolution: energy over one period, the period, tearing."""
+    """The paper's checks at half its resolution: energy over one period, the period, tearing.
+    The period is checked against the linear continuum (finite elements): the issue's
+    Euler-Bernoulli target is 8.8 % below it for this short plate (docs/shtc.md)."""
     res, _ = run_plate(tmp_path / "cp10", "--nw", "20")
     assert res["energy_drift"] < 1e-4, res
     assert res["period_from"] == "full"
-    assert abs(res["period_error_euler_bernoulli"]) < 0.05, res
+    assert abs(res["period_error_continuum"]) < 0.05, res
     assert not res["torn"]
     res0, _ = run_plate(tmp_path / "cp0", "--nw", "20", "--cp-factor", "0")
     assert res0["torn"], res0
