@@ -156,13 +156,18 @@ class SHTCScheme(Scheme):
     ``h`` (the paper uses 1.5 dr with support 2h), particle spacing ``dr``, ``cfl`` of the
     time step dt = cfl dr / sqrt(c0^2 + 4/3 cs^2) (eq. 26, cfl = 0.05), ``masses`` 'kernel'
     (sec. 3.1) or 'lattice' (the masses of the arrays as given), ``theta_det``: relaxation
-    with the |det A|^(5/3) factor of the thesis' eq. 2.11 (the paper omits it).
+    with the |det A|^(5/3) factor of the thesis' eq. 2.11 (the paper omits it).  ``motions``:
+    {moving wall: f(t, pa) -> {property: values}} prescribed at every stage's time (e.g. a
+    rotating ring: positions and velocities), see ``Integrator.add_motion``.
     """
 
     def __init__(self, bodies, dim, rho0, c0, cs, h, dr, tau=math.inf, model="dprz", cp=0.0,
                  walls=(), moving_walls=(), cfl=0.05, masses="kernel", theta_det=False,
-                 kernel="wendland"):
+                 kernel="wendland", motions=None):
         self.bodies, self.walls, self.moving_walls = list(bodies), list(walls), list(moving_walls)
+        self.motions = dict(motions or {})
+        if any(w not in self.moving_walls for w in self.motions):
+            raise InputError(f"SHTCScheme: motions {sorted(self.motions)} must be among moving_walls {self.moving_walls}")
         if not self.bodies:
             raise InputError("SHTCScheme: needs at least one body array")
         if any(w not in self.walls for w in self.moving_walls):
@@ -265,7 +270,10 @@ class SHTCScheme(Scheme):
         steps = {b: SHTCStep(self.dim, model, self.relaxation_rate, detpow, move=True) for b in self.bodies}
         steps.update({w: SHTCStep(self.dim, model, self.relaxation_rate, detpow, move=False)
                       for w in self.walls})
-        return SHTCIntegrator(**steps)
+        integrator = SHTCIntegrator(**steps)
+        for array, motion in self.motions.items():
+            integrator.add_motion(array, motion)
+        return integrator
 
     def output_properties(self, pa):
         props = super().output_properties(pa)
