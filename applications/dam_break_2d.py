@@ -15,6 +15,14 @@ The default ``--dx 0.03`` is PySPH's (h = 0.039 = 1.3 dx), rounded so that L/dx 
 number (dx = 1/33, 33 x 66 = 2178 fluid particles).  The default final time 0.7 s reaches
 T = t sqrt(2 g / L) = 3.1.
 
+``--scheme ctvf`` runs the corrected transport-velocity formulation of Adepu &
+Ramachandran (2021, section 4.3) on the same geometry and walls: continuity density
+(eq. 25) and EDAC pressure (eq. 26), SPST shifting with the free-surface treatment of
+sections 3.4-3.5, free-slip ghost velocities in the divergence terms, alpha = 0.05
+(``--alpha``), nu = 0, p = 0 held on the free-surface particles (``--no-surface-pressure``
+leaves it to the EDAC equation), hydrostatic initial pressure; its energy budget has
+no internal term (EDAC has no equation of state).
+
 ``post_process`` writes ``results.json``: the toe position Z = x_toe/L against T (largest x
 of the fluid within 2 dx of the floor, ejected particles ignored,
 :func:`sphgen.tools.probes.front_position`), its largest relative deviation from Martin &
@@ -36,6 +44,7 @@ from sphgen.particles import ParticleArray
 from sphgen.tools.probes import front_position
 from sphgen.tools import reference
 
+from ..schemes.ctvf import CTVFScheme
 from ..schemes.wcsph import WCSPHScheme
 
 try:
@@ -88,8 +97,11 @@ class DamBreak2D(Application):
         group.add_argument("--dx", type=float, default=0.03,
                            help="particle spacing, rounded so that L/dx is whole (default %(default)s)")
         group.add_argument("--hdx", type=float, default=1.0, help="h / dx (default %(default)s)")
-        group.add_argument("--scheme", choices=("wcsph",), default="wcsph", help="scheme (default %(default)s)")
-        group.add_argument("--alpha", type=float, default=0.1, help="artificial viscosity (default %(default)s)")
+        group.add_argument("--scheme", choices=("wcsph", "ctvf"), default="wcsph", help="scheme (default %(default)s)")
+        group.add_argument("--alpha", type=float, default=None,
+                           help="artificial viscosity (default 0.1 for wcsph, 0.05 for ctvf)")
+        group.add_argument("--no-surface-pressure", dest="surface_pressure", action="store_false",
+                           help="ctvf: do not hold p = 0 on the free-surface particles")
         group.add_argument("--delta", type=float, default=0.1,
                            help="delta-SPH coefficient, 0 turns it off (default %(default)s)")
         group.add_argument("--no-delta-correction", dest="delta_correction", action="store_false",
@@ -109,6 +121,10 @@ class DamBreak2D(Application):
             v = getattr(o, name)
             if not (np.isfinite(v) and v > 0):
                 raise InputError(f"--{name.replace('_', '-')} must be a positive finite number, got {v}")
+        if o.alpha is None:
+            o.alpha = 0.05 if o.scheme == "ctvf" else 0.1
+        if o.scheme == "ctvf":   # no equation of state: no internal energy to sample
+            self.diagnostics = tuple(d for d in type(self).diagnostics if d != "energies")
         for name in ("alpha", "delta"):
             v = getattr(o, name)
             if not (np.isfinite(v) and v >= 0):
@@ -140,12 +156,16 @@ class DamBreak2D(Application):
 
     def create_scheme(self):
         o = self.options
+        if o.scheme == "ctvf":
+            return CTVFScheme(["fluid"], dim=2, rho0=RHO0, c0=self.c0, nu=0.0, h=self.h, dx=self.dx,
+                              umax=sqrt(2.0 * G * H), density="continuity", alpha=o.alpha, gy=-G,
+                              walls=["wall"], free_surface=True, surface_pressure=o.surface_pressure)
         return WCSPHScheme(["fluid"], ["wall"], dim=2, rho0=RHO0, c0=self.c0, h=self.h, gy=-G,
                            alpha=o.alpha, beta=0.0, delta=o.delta, delta_correction=o.delta_correction,
                            umax=sqrt(2.0 * G * H), wall_alpha=bool(o.wall_alpha))
 
     def history_meta(self):
-        return {"dx": self.dx, "h": self.h, "c0": self.c0, "L": L, "m0": self.m0}
+        return {"dx": self.dx, "h": self.h, "c0": self.c0, "L": L, "m0": self.m0, "scheme": self.options.scheme}
 
     # ------------------------------------------------------------ diagnostics
     def post_step(self, solver):
@@ -155,9 +175,17 @@ class DamBreak2D(Application):
 
     def record(self, t):
         f = self.scene.by_name["fluid"]
-        e = self.scheme.energies([f])
+        e = self.energies(f)
         self.history.append([t, t * toe_scale(), *self.row(f, self.dx), e["kinetic"], e["potential"],
                              e["internal"], e["total"], *self.mass_row(f)])
+
+    def energies(self, f):
+        """The scheme's energies; kinetic and potential only for a scheme without them (EDAC)."""
+        if hasattr(self.scheme, "energies"):
+            return self.scheme.energies([f])
+        ke = 0.5 * float(np.sum(f.m * (f.u ** 2 + f.v ** 2)))
+        pe = float(np.sum(f.m * G * f.y))
+        return {"kinetic": ke, "potential": pe, "internal": 0.0, "total": ke + pe}
 
     @staticmethod
     def row(f, dx):
@@ -205,8 +233,9 @@ class DamBreak2D(Application):
             # relative to the potential energy available: m g (H/2 - h_final) ~ half the PE
             "energy_change_rel": float((cols["total"][-1] - e0) / abs(cols["potential"][0])),
         })
+        results["scheme"] = hist.get("scheme", "wcsph")
         io.write_json(os.path.join(outdir, "results.json"), results)
-        self.plot(outdir, T, Z, refs, cols)
+        self.plot(outdir, T, Z, refs, cols, label=f"sphgen {results['scheme'].upper()}")
         print(f"dam_break_2d: T={results['T']:.3g}  toe max deviation over {T_RANGE[0]} <= T <= {T_RANGE[1]}: "
               f"Martin-Moyce (a=2.25in) {_pct(results['toe_max_rel_dev_martin_moyce_a2.25in'])}, "
               f"Koshizuka-Oka {_pct(results['toe_max_rel_dev_koshizuka_oka'])}; "
@@ -216,12 +245,12 @@ class DamBreak2D(Application):
         return results
 
     @staticmethod
-    def plot(outdir, T, Z, refs, cols):
+    def plot(outdir, T, Z, refs, cols, label="sphgen WCSPH"):
         import matplotlib
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
         fig, ax = plt.subplots(figsize=(6, 4.5))
-        ax.plot(T, Z, "k-", label="sphgen WCSPH")
+        ax.plot(T, Z, "k-", label=label)
         marks = {"martin_moyce_a2.25in": ("bo", "Martin & Moyce 1952 (a = 2.25 in)"),
                  "martin_moyce_a1.125in": ("bs", "Martin & Moyce 1952 (a = 1.125 in)"),
                  "koshizuka_oka": ("r^", "Koshizuka & Oka 1996")}

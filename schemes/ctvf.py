@@ -9,8 +9,11 @@ equation keeps both transport terms of eq. 19 (eq. 27), and the density is summe
 Kick-drift-kick (eqs. 54-60); time step eq. 61.  Each correction is a switch, so the
 paper's "without corrections" runs are the same scene with the terms switched off.
 
-Fluids only, periodic or open: walls (section 3.6) and solids enter later as extra
-sources (``_sources``) and extra groups before the momentum group (``_wall_groups``).
+Walls (section 3.6): Adami et al. (2012) ghost particles (``walls``, ``moving_walls``), with
+the free-slip ghost velocities of eqs. 46-49 in every divergence term (they are the walls'
+``u, v, w`` and ``uhat, vhat, what``, :class:`~sphgen.equations.transport_walls.WallSlipVelocity`)
+and the no-slip ghost velocity of eq. 50 in the viscous term; pressure extrapolated by
+eq. 52 and the wall density from the linear equation of state.  Solids enter later.
 """
 from math import sqrt
 
@@ -23,9 +26,14 @@ from ..equations.basic import SummationDensity, Vorticity2D
 from ..equations.ctvf import (ContinuityTransportCorrection, EDACTransportCorrection,
                               MomentumTransportDivergence)
 from ..equations.edac import EDACPressureRate
+from ..equations.free_surface import (SurfacePressure, SurfaceShiftingFilter, free_surface_groups,
+                                      setup_free_surface_properties)
 from ..equations.momentum import ArtificialViscosity, AveragePressure, LaminarViscosity, PressureGradient
 from ..equations.shifting import Shifting
 from ..equations.transport import TransportContinuity, TransportStress
+from ..equations.transport_walls import WallSlipVelocity
+from ..equations.walls import (WallArtificialViscosity, WallDensity, WallGhostVelocity, WallPressure,
+                               WallViscosity)
 from ..equations.wcsph import BodyForce
 
 DENSITIES = ("summation", "continuity")
@@ -100,8 +108,13 @@ def transport_timestep(h, c0, umax, nu, g=0.0):
 
 class TransportVelocityScheme(Scheme):
     """What the transport-velocity schemes share: checks, kernel, homogenisation
-    (:class:`~sphgen.equations.shifting.Shifting`), properties, the KDK integrator, the
-    time step (eq. 61) and the guards.  Subclasses give ``get_equations``."""
+    (:class:`~sphgen.equations.shifting.Shifting`), properties, walls, the KDK integrator,
+    the time step (eq. 61) and the guards.  Subclasses give ``get_equations``.
+
+    ``walls``: names of wall arrays (fixed particles with ``m``, ``h``, ``rho`` and unit
+    ``normal`` into the fluid, stride 3); ``moving_walls``: those among them with a
+    prescribed velocity ``uw, vw, ww`` (Adepu & Ramachandran 2021, section 3.6).
+    """
 
     output_props = ("x", "y", "z", "u", "v", "w", "p", "rho", "m", "h")
     evolve_pressure = True
@@ -109,7 +122,7 @@ class TransportVelocityScheme(Scheme):
     def __init__(self, fluids, dim, rho0, c0, nu, h, dx, umax=1.0, shifting="spst",
                  density="summation", alpha=0.0, mach=None, pb=None, p_ref=None,
                  kernel="quintic", gx=0.0, gy=0.0, gz=0.0, ipst_tolerance=0.02,
-                 ipst_max_iterations=10, ipst_interval=1):
+                 ipst_max_iterations=10, ipst_interval=1, walls=(), moving_walls=()):
         for name, v in (("rho0", rho0), ("c0", c0), ("h", h), ("dx", dx), ("umax", umax)):
             if not v > 0:
                 raise ValueError(f"{type(self).__name__}: {name}={v!r} must be > 0")
@@ -118,6 +131,10 @@ class TransportVelocityScheme(Scheme):
         if density not in DENSITIES:
             raise ValueError(f"density must be one of {', '.join(DENSITIES)}; got {density!r}")
         self.fluids, self.dim = list(fluids), int(dim)
+        self.walls, self.moving_walls = list(walls), list(moving_walls)
+        if any(w not in self.walls for w in self.moving_walls):
+            raise ValueError(f"{type(self).__name__}: moving_walls {self.moving_walls} must be among "
+                             f"walls {self.walls}")
         self.rho0, self.c0, self.nu, self.h, self.dx, self.umax = rho0, c0, nu, h, dx, umax
         self.density, self.alpha = density, alpha
         self.gx, self.gy, self.gz = gx, gy, gz
@@ -143,10 +160,47 @@ class TransportVelocityScheme(Scheme):
                     pa.add_property(p)
             if pa.name in self.fluids:
                 self.shift.setup_properties(pa)
+            if pa.name in self.walls:
+                for p in ("wij", "ug", "vg", "wg", "uw", "vw", "ww", "uhat", "vhat", "what"):
+                    if not pa.has(p):
+                        pa.add_property(p)
+                if not pa.has("normal"):
+                    raise ValueError(f"wall {pa.name!r} needs unit normals 'normal' (stride 3) into the fluid")
 
     def _sources(self, dest):
-        """Neighbour arrays of a fluid (walls will join here)."""
+        """Neighbours of a fluid in the pressure gradient, the density, the divergence
+        terms and the homogenisation: the fluids and the walls."""
+        return list(self.fluids) + self.walls
+
+    def _fluid_sources(self, dest):
+        """Neighbours of a fluid in the viscous terms (walls enter through their ghost velocity)."""
         return list(self.fluids)
+
+    def _viscous_equations(self, dest):
+        """Morris viscosity and artificial viscosity, fluid-fluid, and against the walls with
+        the no-slip ghost velocity (eq. 50) and the prescribed wall velocity."""
+        src = self._fluid_sources(dest)
+        eqs = [LaminarViscosity(dest, src, nu=self.nu),
+               ArtificialViscosity(dest, src, alpha=self.alpha, c0=self.c0)]
+        if self.walls:
+            eqs.append(WallViscosity(dest, self.walls, nu=self.nu, dim=self.dim))
+            eqs += [WallArtificialViscosity(dest, [w], alpha=self.alpha, c0=self.c0,
+                                            moving=w in self.moving_walls, dim=self.dim) for w in self.walls]
+        return eqs
+
+    def _wall_groups(self):
+        """Wall pressure (eq. 52) and density (linear equation of state), the no-slip ghost
+        velocity (eq. 50) and the free-slip ghost velocities (eqs. 46-49); [] without walls."""
+        if not self.walls:
+            return []
+        eqs = []
+        for w in self.walls:
+            moving = w in self.moving_walls
+            eqs += [WallPressure(w, self.fluids, gx=self.gx, gy=self.gy, gz=self.gz, dim=self.dim),
+                    WallDensity(w, eos="linear", rho0=self.rho0, c0=self.c0),
+                    WallGhostVelocity(w, self.fluids, slip=False, moving=moving, dim=self.dim),
+                    WallSlipVelocity(w, self.fluids, moving=moving, dim=self.dim)]
+        return [Group(eqs)]
 
     def _body_force(self, dest):
         if self.gx or self.gy or self.gz:
@@ -190,11 +244,25 @@ class CTVFScheme(TransportVelocityScheme):
     artificial viscosity (eq. 28; 0 removes it).  ``alpha_edac``: eq. 24.  ``gx, gy,
     gz``: body force.  IPST: ``ipst_tolerance``, ``ipst_max_iterations``,
     ``ipst_interval``.  Other keywords as :class:`TransportVelocityScheme`.
+
+    Free surfaces (``free_surface=True``): every evaluation at new positions identifies
+    the free-surface particles and their normals (section 3.4, cone test within
+    ``cone_radius`` h) and h_b (section 3.5), and the SPST acceleration loses its normal
+    part near the surface and all of it on the surface (eq. 44; IPST's eq. 45 is not
+    implemented).  ``surface_pressure``: also hold p = 0 on free-surface particles (not
+    in the paper; see docs/ctvf.md).
     """
 
     def __init__(self, fluids, dim, rho0, c0, nu, h, dx, umax=1.0, shifting="spst",
-                 corrections=CORRECTIONS, alpha_edac=0.5, bql=False, **kw):
+                 corrections=CORRECTIONS, alpha_edac=0.5, bql=False, free_surface=False,
+                 surface_pressure=False, cone_radius=2.0, **kw):
         super().__init__(fluids, dim, rho0, c0, nu, h, dx, umax=umax, shifting=shifting, **kw)
+        if free_surface and self.shift.kind == "ipst":
+            raise ValueError("free surfaces with IPST (eq. 45) are not implemented; use shifting='spst'")
+        if surface_pressure and not free_surface:
+            raise ValueError("surface_pressure needs free_surface=True")
+        self.free_surface, self.surface_pressure = bool(free_surface), bool(surface_pressure)
+        self.cone_radius = cone_radius
         bad = sorted(set(corrections) - set(CORRECTIONS))
         if bad:
             raise ValueError(f"unknown correction {bad[0]!r}; known: {', '.join(CORRECTIONS)}")
@@ -204,6 +272,20 @@ class CTVFScheme(TransportVelocityScheme):
         self.stress_correction = "stress" in on
         self.divergence_correction = "divergence" in on
         self.continuity_correction = "continuity" in on and self.density == "continuity"
+
+    def setup_properties(self, arrays):
+        super().setup_properties(arrays)
+        if self.free_surface:
+            for pa in arrays:
+                if pa.name in self.fluids:
+                    setup_free_surface_properties(pa)
+
+    def _surface_groups(self):
+        """Free-surface particles, normals and h_b (sections 3.4-3.5); [] without."""
+        if not self.free_surface:
+            return []
+        return free_surface_groups(self.fluids, self.walls, rho0=self.rho0, radius=self.cone_radius,
+                                   h_b_factor=self.kernel.radius_scale)
 
     def nu_edac(self):
         """nu_edac = alpha_edac h c0 / 8 (Adepu & Ramachandran 2021, eq. 24)."""
@@ -227,7 +309,7 @@ class CTVFScheme(TransportVelocityScheme):
             if self.density == "summation":
                 eqs.append(SummationDensity(d, self._sources(d)))
             if self.bql:
-                eqs.append(AveragePressure(d, self._sources(d)))
+                eqs.append(AveragePressure(d, self._fluid_sources(d)))
         return [Group(eqs)] if eqs else []
 
     def _momentum_group(self):
@@ -235,17 +317,21 @@ class CTVFScheme(TransportVelocityScheme):
         eqs = []
         for d in self.fluids:
             src = self._sources(d)
-            eqs += [PressureGradient(d, src, bql=self.bql),
-                    LaminarViscosity(d, src, nu=self.nu),
-                    ArtificialViscosity(d, src, alpha=self.alpha, c0=self.c0),
-                    TransportStress(d, src, enabled=self.stress_correction),
+            eqs += [PressureGradient(d, src, bql=self.bql)] + self._viscous_equations(d)
+            eqs += [TransportStress(d, src, enabled=self.stress_correction),
                     MomentumTransportDivergence(d, src, enabled=self.divergence_correction)]
             eqs += self._body_force(d) + self.shift.momentum_equations(d, src)
             if self.dim == 2:
-                eqs.append(Vorticity2D(d, src))
+                eqs.append(Vorticity2D(d, self._fluid_sources(d)))
         return Group(eqs)
 
     def get_equations(self):
         src = self._sources(self.fluids[0])
-        second = self._density_groups() + [self._momentum_group()] + self.shift.groups(self.fluids, src)
-        return [[self._rate_group()], second]
+        second = (self._density_groups() + self._wall_groups() + self._surface_groups()
+                  + [self._momentum_group()] + self.shift.groups(self.fluids, src))
+        first = self._wall_groups() + [self._rate_group()]
+        if self.free_surface and self.shift.active:
+            second.append(Group([SurfaceShiftingFilter(d) for d in self.fluids]))
+        if self.surface_pressure:
+            first.append(Group([SurfacePressure(d) for d in self.fluids]))
+        return [first, second]

@@ -16,12 +16,14 @@ the baseline the CTVF of Adepu & Ramachandran (2021) improves on.
   so that the two schemes differ only in their equations.
 
 No CTVF corrections: no -u div(u~ - u) term, and the pressure follows the density.
+Walls as in the CTVF scheme (Adami et al. 2012 ghost particles, free-slip ghost
+velocities in the continuity and transport terms, no-slip in the viscous term).
 """
 from sphgen.equation import Group
 
 from ..equations.basic import SummationDensity, Vorticity2D
 from ..equations.density import CorrectedSummationDensity, SaveDensity
-from ..equations.momentum import ArtificialViscosity, LaminarViscosity, PressureGradient
+from ..equations.momentum import PressureGradient
 from ..equations.transport import TransportContinuity, TransportStress
 from ..equations.wcsph import TaitEOS
 from .ctvf import TransportVelocityScheme
@@ -60,7 +62,7 @@ class GTVFScheme(TransportVelocityScheme):
         """Density (eq. 13, or summation), then p = c0^2 (rho - rho0)."""
         groups = []
         if self.density == "continuity":
-            groups += [Group([SaveDensity(d) for d in self.fluids]),
+            groups += [Group([SaveDensity(d) for d in self.fluids + self.walls]),
                        Group([CorrectedSummationDensity(d, self._sources(d)) for d in self.fluids])]
         else:
             groups.append(Group([SummationDensity(d, self._sources(d)) for d in self.fluids]))
@@ -72,16 +74,16 @@ class GTVFScheme(TransportVelocityScheme):
         eqs = []
         for d in self.fluids:
             src = self._sources(d)
-            eqs += [PressureGradient(d, src, bql=False),
-                    LaminarViscosity(d, src, nu=self.nu),
-                    ArtificialViscosity(d, src, alpha=self.alpha, c0=self.c0),
-                    TransportStress(d, src, enabled=self.shift.active)]
+            eqs += [PressureGradient(d, src, bql=False)] + self._viscous_equations(d)
+            eqs += [TransportStress(d, src, enabled=self.shift.active)]
             eqs += self._body_force(d) + self.shift.momentum_equations(d, src)
             if self.dim == 2:
-                eqs.append(Vorticity2D(d, src))
+                eqs.append(Vorticity2D(d, self._fluid_sources(d)))
         return Group(eqs)
 
     def get_equations(self):
         src = self._sources(self.fluids[0])
-        second = self._density_groups() + [self._momentum_group()] + self.shift.groups(self.fluids, src)
-        return [self._rate_groups(), second]
+        second = (self._density_groups() + self._wall_groups() + [self._momentum_group()]
+                  + self.shift.groups(self.fluids, src))
+        rates = self._rate_groups()
+        return [(self._wall_groups() + rates) if rates else [], second]

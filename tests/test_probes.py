@@ -179,3 +179,34 @@ def test_front_position_from_output_files(tmp_path):
     io.write(path, [pa], {"t": 0.0, "dt": 1e-4, "step": 0})
     f = io.load(path)["arrays"]["fluid"]
     assert np.isclose(probes.front_position(f.x, f.y, 0.0, dx), 1.4 - dx / 2)
+
+
+# ------------------------------------------------------------------ voids
+def test_nearest_distance_matches_brute_force():
+    rng = np.random.default_rng(7)
+    X = (rng.uniform(0, 1, 300), rng.uniform(0, 1, 300))
+    P = (rng.uniform(-0.5, 1.5, 50), rng.uniform(-0.5, 1.5, 50))
+    brute = np.hypot(P[0][:, None] - X[0][None], P[1][:, None] - X[1][None]).min(axis=1)
+    np.testing.assert_allclose(probes.nearest_distance(P, X, 0.01), brute, rtol=1e-14)
+
+
+@pytest.mark.parametrize("k", [0, 1, 3])
+def test_largest_empty_disc_of_a_lattice_with_a_hole(k):
+    """Square lattice: dx/sqrt(2) (a cell's centre); a k x k block removed (k odd): (k + 1)/2 dx."""
+    dx = 0.05
+    x, y = geometry.square_lattice(dx, 0.0, 1.0, 0.0, 1.0)
+    cx, cy = x[210], y[210]   # an interior particle
+    hole = (np.abs(x - cx) < 0.5 * k * dx) & (np.abs(y - cy) < 0.5 * k * dx)
+    assert hole.sum() == k * k
+    r = probes.largest_empty_disc((x[~hole], y[~hole]), (0.0, 1.0, 0.0, 1.0)) / dx
+    expect = 1.0 / np.sqrt(2.0) if k == 0 else 0.5 * (k + 1)
+    assert abs(r - expect) < 1e-3, (k, r)
+
+
+def test_largest_empty_disc_3d_and_bad_bounds():
+    dx = 0.1
+    x, y, z = geometry.cubic_lattice(dx, 0.0, 1.0, 0.0, 1.0, 0.0, 1.0)
+    r = probes.largest_empty_disc((x, y, z), (0.0, 1.0, 0.0, 1.0, 0.0, 1.0))
+    assert abs(r / dx - np.sqrt(3.0) / 2.0) < 1e-3
+    with pytest.raises(ValueError, match="bounds"):
+        probes.largest_empty_disc((x, y, z), (0.0, 1.0, 0.0, 1.0))

@@ -1,4 +1,5 @@
-"""Post-processing probes: SPH interpolation at points, lines, material points, the dam-break front.
+"""Post-processing probes: SPH interpolation at points, lines, material points, the dam-break
+front, the largest void.
 
 Everything works on plain numpy arrays (from a live run or from output files), with a
 vectorised cell search in numpy; fine for probes of a few thousand points on ~1e5 particles.
@@ -224,3 +225,74 @@ def front_position(x, y, floor_y, dx, neighbour_counts=None, band=2.0, radius=No
     counts = np.asarray(neighbour_counts, dtype=float)
     keep = (y - floor_y <= band * dx) & (counts >= min_fraction * np.median(counts))
     return float(x[keep].max()) if keep.any() else float("nan")
+
+
+# ------------------------------------------------------------------ voids
+def nearest_distance(points, positions, radius):
+    """Distance from each point to its nearest particle (the search radius starts at
+    ``radius`` and doubles for the points that found nobody); inf without particles."""
+    P = [np.asarray(c, dtype=float).ravel() for c in points]
+    npts = P[0].size
+    d = np.full(npts, np.inf)
+    if npts == 0 or np.size(positions[0]) == 0:
+        return d
+    pending = np.arange(npts)
+    r = float(radius)
+    extent = max(float(np.ptp(np.concatenate([P[k], np.asarray(positions[k], float).ravel()])))
+                 for k in range(len(P)))
+    while pending.size:
+        i, _, rr = pairs_within(tuple(p[pending] for p in P), positions, r)
+        best = np.full(pending.size, np.inf)
+        np.minimum.at(best, i, rr)
+        found = np.isfinite(best)
+        d[pending[found]] = best[found]
+        pending = pending[~found]
+        if r > 2.0 * extent + radius:
+            break
+        r *= 2.0
+    return d
+
+
+def largest_empty_disc(positions, bounds, spacing=None, refine=8):
+    """Radius of the largest disc (sphere in 3D) with its centre inside ``bounds`` =
+    (xmin, xmax, ymin, ymax[, zmin, zmax]) that holds no particle: the size of a void.
+
+    Candidate centres on a grid of ``spacing``/4 (default spacing: the mean particle
+    spacing (volume / N)^(1/dim)); the best ``refine`` of them are improved by a compass
+    search (step halved down to 1e-3 spacing) towards the local maximum of the distance
+    to the nearest particle.  On a square lattice of spacing dx the result is dx/sqrt(2)
+    (the centre of a cell); with a k x k block of particles removed (k odd), (k + 1)/2 dx.
+    Pass the walls too, so that a void against a wall is bounded by them.
+    """
+    X = [np.asarray(c, dtype=float).ravel() for c in positions]
+    dim = len(X)
+    lo = np.array(bounds[0::2], dtype=float)
+    hi = np.array(bounds[1::2], dtype=float)
+    if len(lo) != dim or np.any(hi <= lo):
+        raise ValueError(f"bounds {bounds!r} must be (min, max) pairs for {dim} dimensions")
+    if X[0].size == 0:
+        return float(np.linalg.norm(hi - lo))
+    if spacing is None:
+        spacing = float(np.prod(hi - lo) / X[0].size) ** (1.0 / dim)
+    step = spacing / 4.0
+    axes = [np.linspace(a, b, max(2, int(np.ceil((b - a) / step)) + 1)) for a, b in zip(lo, hi)]
+    grid = [g.ravel() for g in np.meshgrid(*axes, indexing="ij")]
+    d = nearest_distance(grid, X, 2.0 * spacing)
+    order = np.argsort(d)[::-1][:refine]
+    best = float(d[order[0]])
+    dirs = np.array([v for v in itertools.product((-1.0, 0.0, 1.0), repeat=dim) if any(v)])
+    dirs /= np.linalg.norm(dirs, axis=1)[:, None]
+    for k in order:
+        c = np.array([g[k] for g in grid])
+        dc = float(d[k])
+        s = step
+        while s > 1e-3 * spacing:
+            trial = np.clip(c + s * dirs, lo, hi)
+            dt = nearest_distance(tuple(trial.T), X, dc + 2.0 * s)
+            j = int(np.argmax(dt))
+            if dt[j] > dc:
+                c, dc = trial[j], float(dt[j])
+            else:
+                s *= 0.5
+        best = max(best, dc)
+    return best
