@@ -114,6 +114,11 @@ class Application:
         g.add_argument("--dt", type=_positive_float, default=None, help="time step (default: the scheme's)")
         g.add_argument("--dt-factor", type=_positive_float, default=1.0,
                        help="multiply the time step by this (default 1; above 1 needs --allow-unstable)")
+        g.add_argument("--skin", type=_nonneg_float, default=0.1,
+                       help="Verlet skin of the neighbour search, as a fraction of the support: "
+                            "cells and candidate lists are kept while it covers the motion "
+                            "(the neighbour lists, and so the results, are the same; default "
+                            "%(default)s)")
         g.add_argument("--max-steps", type=_positive_int, default=None, help="stop after this many steps")
         g.add_argument("--openmp", dest="openmp", action="store_true", default=True,
                        help="use all cores (default)")
@@ -192,7 +197,7 @@ class Application:
         return Scene(arrays, self.scheme.get_equations(), steppers=integrator.steppers,
                      kernel=getattr(self.scheme, "kernel", None), dim=self.dim,
                      domain=self.create_domain(), outputs=outputs, backend=opts.backend,
-                     threads=1 if not opts.openmp else opts.threads)
+                     threads=1 if not opts.openmp else opts.threads, skin=opts.skin)
 
     def _solver(self, integrator, dt):
         opts = self.options
@@ -310,6 +315,7 @@ class Application:
             "thread_choices": s.tuner.choices if s.tuner else [],
             "time_per_particle_step": s.wall_time / (steps * max(n, 1)),
             "neighbour_pairs_per_step": self.neighbour_pairs_per_step() if completed else None,
+            "neighbour_updates": sc.nnps.n_updates, "neighbour_builds": sc.nnps.n_builds,
             "generated_source": getattr(sc, "source_path", None),
             "restarts": self.restarts, "options": vars(opts),
             "finished_at": time.strftime("%Y-%m-%dT%H:%M:%S"),

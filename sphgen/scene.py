@@ -25,7 +25,7 @@ class Scene:
     """Everything one simulation computes, specialised and compiled once."""
 
     def __init__(self, arrays, equations, steppers=None, kernel=None, dim=2, domain=None,
-                 outputs=None, backend="cython", threads=None):
+                 outputs=None, backend="cython", threads=None, skin=0.0):
         if backend not in BACKENDS:
             raise ValueError(f"backend must be {' or '.join(map(repr, BACKENDS))}, got {backend!r}")
         self.arrays = list(arrays)
@@ -44,7 +44,8 @@ class Scene:
         for pa in self.arrays:
             for p in self.plan.allocation[pa.name]:
                 pa.allocate(p)
-        self.nnps = NeighbourSearch(self.searched_arrays(), dim, self.kernel.radius_scale, domain)
+        self.nnps = NeighbourSearch(self.searched_arrays(), dim, self.kernel.radius_scale, domain,
+                                    skin=skin)
         self.backend = backend
         self.engine = BACKENDS[backend](self.plan, self.nnps)
         self.setup_time = time.perf_counter() - t0

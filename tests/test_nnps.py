@@ -431,3 +431,60 @@ def test_sort_rejects_a_frozen_list_of_another_particle_count():
         pa.data[p] = pa.data[p][:80].copy()
     with pytest.raises(ValueError, match="particle count change since freeze"):
         nn.sort()
+
+
+# ----------------------------------------------------------------- Verlet skin
+def _drift(pa, dim, step, scale):
+    """A smooth, particle-dependent motion and a slow growth of h."""
+    idx = np.arange(pa.n)
+    for a in range(dim):
+        pa.get(AXES[a])[:] += scale * (1.0 + np.sin(0.37 * idx + a + 0.1 * step))
+    pa.get("h")[:] *= 1.0005
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+@pytest.mark.parametrize("dim", [1, 2, 3])
+@pytest.mark.parametrize("periodic", [False, True])
+def test_skin_gives_the_exact_lists_and_rebuilds_only_when_needed(dim, periodic, threads,
+                                                                   monkeypatch):
+    """Lists cut from a skin list equal a fresh exact build (and brute force), entry for
+    entry, through motion, growth of h, rebuilds and reuse; two arrays, variable h."""
+    monkeypatch.setenv("OMP_NUM_THREADS", str(threads))
+    rng = np.random.default_rng(40 + dim)
+    n = {1: 150, 2: 500, 3: 800}[dim]
+    h = {1: 0.02, 2: 0.04, 3: 0.08}[dim]
+    dom = domain_for((periodic,) * dim)
+    skinned = [make_array(nm, n, dim, rng, h=h, hvar=0.2) for nm in ("f", "w")]
+    exact = [ParticleArray(pa.name, **{k: pa.get(k).copy() for k in AXES + ("h", "id")})
+             for pa in skinned]
+    with_skin = NeighbourSearch(skinned, dim, 2.0, dom, sort=False, skin=0.15)
+    fresh = NeighbourSearch(exact, dim, 2.0, dom, sort=False)
+    for step in range(30):
+        for group in (skinned, exact):
+            _drift(group[0], dim, step, 0.001 * h / 0.04)    # only f moves
+            group[1].get("h")[:] *= 1.0005
+        with_skin.update()
+        fresh.update()
+        for d, s in (("f", "f"), ("f", "w"), ("w", "f")):
+            assert_same_lists(with_skin.neighbours(d, s), fresh.neighbours(d, s))
+    assert_same_lists(with_skin.neighbours("f", "w"),
+                      brute_force(skinned[0], skinned[1], dim, 2.0, dom))
+    assert with_skin.skin_distance > 0
+    assert 2 <= with_skin.n_builds < with_skin.n_updates // 2    # reused, and rebuilt
+    assert fresh.n_builds == fresh.n_updates + 1
+
+
+def test_skin_rebuilds_at_once_for_a_large_jump_or_a_new_particle_count():
+    rng = np.random.default_rng(9)
+    pa = make_array("f", 300, 2, rng, h=0.03)
+    nn = NeighbourSearch([pa], 2, 3.0, sort=False, skin=0.2)
+    builds = nn.n_builds
+    pa.get("x")[:] += 1e-6
+    nn.update()
+    assert nn.n_builds == builds                   # tiny motion: the lists are reused
+    pa.get("x")[0] += 0.5 * nn.skin_distance + 1e-9
+    nn.update()
+    assert nn.n_builds == builds + 1               # one particle beyond half the skin
+    assert_same_lists(nn.neighbours("f", "f"), brute_force(pa, pa, 2, 3.0))
+    with pytest.raises(ValueError, match="skin"):
+        NeighbourSearch([pa], 2, 3.0, skin=-0.1)

@@ -20,8 +20,8 @@ import math
 
 import numpy as np
 
-from ._cell_list import (GridSpec, RowBuffers, bin_particles, build_csr, remap_csr, scan,
-                         wrap_periodic)
+from ._cell_list import (GridSpec, RowBuffers, bin_particles, build_csr, refine_csr, remap_csr,
+                         scan, wrap_periodic)
 
 __all__ = ["Domain", "NeighbourSearch", "NotFrozenError"]
 
@@ -114,6 +114,15 @@ class NeighbourSearch:
     sort : bool
         If True, spatially sort the arrays once at construction (:meth:`sort`
         permutes them in place).
+    skin : float
+        Verlet skin as a fraction of the largest support ``k max(h)`` (0: none).  With
+        a skin, the cells and a list of the pairs closer than ``k max(h_i, h_j) + s``
+        (``s = skin k max(h)`` at the last rebuild) are kept by :meth:`update` while
+        they still hold every pair that can be in reach (twice the largest
+        displacement since the rebuild plus ``k`` times the largest change of ``h``
+        at most ``s``), and the exact lists are cut from them at each update (one
+        scan of the candidates, :func:`refine_csr`).  The lists returned are the same
+        either way.
 
     Notes
     -----
@@ -121,11 +130,12 @@ class NeighbourSearch:
     the positions and ``h``: the lists describe the particles as they were at the
     last update, so call it whenever positions or ``h`` changed.
 
-    Attributes: ``n_updates``, ``grid`` (the cell grid), ``cell_size`` and
-    ``n_cells`` (per axis), ``arrays``, ``dim``, ``radius_scale``, ``domain``.
+    Attributes: ``n_updates``, ``n_builds`` (updates that rebuilt the cells),
+    ``grid`` (the cell grid), ``cell_size`` and ``n_cells`` (per axis), ``arrays``,
+    ``dim``, ``radius_scale``, ``domain``, ``skin``, ``skin_distance`` (``s``).
     """
 
-    def __init__(self, arrays, dim, radius_scale, domain=None, sort=True):
+    def __init__(self, arrays, dim, radius_scale, domain=None, sort=True, skin=0.0):
         arrays = list(arrays)
         if not arrays:
             raise ValueError("NeighbourSearch needs at least one particle array")
@@ -151,7 +161,16 @@ class NeighbourSearch:
         self.dim = int(dim)
         self.radius_scale = radius_scale
         self.domain = domain
+        skin = float(skin)
+        if not (math.isfinite(skin) and skin >= 0):
+            raise ValueError(f"NeighbourSearch: skin must be >= 0, got {skin}")
+        self.skin = skin
+        self.skin_distance = 0.0
         self.n_updates = 0
+        self.n_builds = 0
+        self._built_at = None    # positions and h at the last rebuild (with a skin)
+        self._skin_lists = {}    # (dest, src) -> lists with the skin, since the rebuild
+        self._scratch = {}       # (dest, src) -> int32 scratch of refine_csr
         self._by_name = dict(zip(names, arrays))
         self._cache = {}
         self._frozen = {}
@@ -189,9 +208,38 @@ class NeighbourSearch:
     # ------------------------------------------------------------ building
     def update(self):
         """Wrap positions into the periodic box (in place, periodic axes only),
-        rebuild the cell lists and drop the cached neighbour lists."""
-        self._build()
+        rebuild the cell lists (unless a skin still covers the motion since the last
+        rebuild) and drop the cached neighbour lists."""
         self.n_updates += 1
+        if self._built_at is not None and self._within_skin():
+            self._cache = {}
+            return
+        self._build()
+
+    def _within_skin(self):
+        """Wrap positions; True if no pair can have come within reach since the rebuild."""
+        dom = self.domain
+        moved2, dh = 0.0, 0.0
+        for pa in self.arrays:
+            ref = self._built_at[pa.name]
+            if pa.n != self._sizes[pa.name]:
+                return False
+            if not pa.n:
+                continue
+            d2 = np.zeros(pa.n)
+            for a in range(self.dim):
+                x = self._checked(pa, _AXES[a])
+                if dom.periodic[a] and wrap_periodic(x, dom.lo[a], dom.length[a]) >= 0:
+                    return False              # non-finite: the rebuild names it
+                d = x - ref[a]
+                if dom.periodic[a]:
+                    d -= dom.length[a] * np.round(d / dom.length[a])
+                d2 += d * d
+            moved2 = max(moved2, float(d2.max()))
+            dh = max(dh, float(np.abs(self._checked(pa, "h") - ref[-1]).max()))
+        if not (math.isfinite(moved2) and math.isfinite(dh)):
+            return False
+        return 2.0 * math.sqrt(moved2) + self.radius_scale * dh <= self.skin_distance
 
     def _build(self):
         dom, dim = self.domain, self.dim
@@ -229,14 +277,26 @@ class NeighbourSearch:
                     f"periodic {_AXES[a]}-length {dom.length[a]} is less than twice the "
                     f"largest cut-off radius_scale*max(h) = {cutoff}: the minimum image is "
                     "not unique (enlarge the box or reduce h)")
-        self._make_grid(lo, hi, cutoff * _CELL_MARGIN, ntotal)
+        skin = self.skin * cutoff
+        for a in range(dim):     # the minimum image must stay unique for the skin too
+            if dom.periodic[a]:
+                skin = min(skin, max(0.0, 0.5 * dom.length[a] / _CELL_MARGIN - cutoff))
+        self.skin_distance = skin
+        self._make_grid(lo, hi, (cutoff + skin) * _CELL_MARGIN, ntotal)
         self._bins = {}
         self._sizes = {}
         for pa in self.arrays:
             self._bins[pa.name] = bin_particles(self.grid, self._coords(pa), pa.get("h"),
-                                                 self.radius_scale)
+                                                 self.radius_scale, skin)
             self._sizes[pa.name] = pa.n
         self._cache = {}
+        self._skin_lists = {}
+        self.n_builds += 1
+        if skin > 0:
+            self._built_at = {pa.name: [self._checked(pa, _AXES[a]).copy() for a in range(dim)]
+                              + [self._checked(pa, "h").copy()] for pa in self.arrays}
+        else:
+            self._built_at = None
 
     def _checked(self, pa, prop):
         """The float64 contiguous array of ``prop`` with ``pa.n`` entries."""
@@ -307,10 +367,24 @@ class NeighbourSearch:
                 if pa.n != self._sizes[pa.name]:
                     raise RuntimeError(f"array '{pa.name}' has {pa.n} particles but had "
                                        f"{self._sizes[pa.name]} at the last update(): call update()")
-            rows = self._rows.setdefault(key, RowBuffers())
-            lists = build_csr(self.grid, self._bins[d.name], self._bins[s.name], buffers=rows)
+            lists = self._skin_lists.get(key)
+            if lists is None:
+                rows = self._rows.setdefault(key, RowBuffers())
+                lists = build_csr(self.grid, self._bins[d.name], self._bins[s.name], buffers=rows)
+            if self.skin_distance > 0:
+                self._skin_lists[key] = lists
+                lists = self._refine(d, s, lists)
             self._cache[key] = lists
         return lists
+
+    def _refine(self, d, s, lists):
+        """The exact lists of (d, s) now, cut from ``lists`` (built with the skin)."""
+        key = (d.name, s.name)
+        scratch = self._scratch.get(key)
+        if scratch is None or scratch.size < lists[1].size:
+            scratch = self._scratch[key] = np.empty(int(1.25 * lists[1].size) + 16, dtype=np.int32)
+        return refine_csr(self.grid, lists[0], lists[1], self._coords(d), d.get("h"),
+                          self._coords(s), s.get("h"), self.radius_scale, scratch)
 
     def freeze(self, dest, src):
         """Keep the current lists of (dest, src) as the fixed reference list (Total

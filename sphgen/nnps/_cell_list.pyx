@@ -625,14 +625,16 @@ def scan(double[::1] x):
     return lo, hi, -1
 
 
-def bin_particles(GridSpec grid, list coords, double[::1] h, double radius_scale):
+def bin_particles(GridSpec grid, list coords, double[::1] h, double radius_scale,
+                  double skin=0.0):
     """Bin particles into the grid's cells (stable counting sort).
 
     ``coords`` holds the x, y, z arrays (entries past ``dim`` are not read).
     Returns ``(cell_start, cell_index, pts)``: the particles of the cell of rank ``r``
     are ``cell_index[cell_start[r]:cell_start[r+1]]`` (ascending) and ``pts[p]`` is
-    ``(x, y, z, (k h)**2)`` of particle ``cell_index[p]`` (unused axes 0), with ``k``
-    the radius scale."""
+    ``(x, y, z, (k h + skin)**2)`` of particle ``cell_index[p]`` (unused axes 0), with
+    ``k`` the radius scale: lists built from these bins hold the pairs closer than
+    ``k max(h_i, h_j) + skin``."""
     cdef const Grid* g = &grid.c
     cdef Py_ssize_t n = h.shape[0], ncells = grid.ncells, i, p
     cdef int a, c, lin
@@ -667,7 +669,7 @@ def bin_particles(GridSpec grid, list coords, double[::1] h, double radius_scale
         i = cell_index[p]
         for a in range(g.dim):
             pts[p, a] = x[a][i]
-        pts[p, 3] = (radius_scale * h[i]) * (radius_scale * h[i])
+        pts[p, 3] = (radius_scale * h[i] + skin) * (radius_scale * h[i] + skin)
     return start_arr, index_arr, pts_arr
 
 
@@ -756,4 +758,74 @@ def remap_csr(int[::1] offsets, int[::1] nbrs, int[::1] perm_dest, int[::1] inv_
                 free(tmp)
     if failed:
         raise MemoryError("out of memory while remapping a neighbour list")
+    return new_off_arr, new_nbrs_arr
+
+
+def refine_csr(GridSpec grid, int[::1] offsets, int[::1] nbrs, list dest_coords,
+               double[::1] dest_h, list src_coords, double[::1] src_h, double radius_scale,
+               int[::1] scratch):
+    """The exact lists (``|r_ij| < k max(h_i, h_j)`` now) from lists with a skin.
+
+    ``offsets``/``nbrs`` hold, for every destination, a superset of its neighbours (a
+    list built with a skin that still covers the motion); the coordinates and ``h`` are
+    the current ones.  Each row keeps its order; the test is the one :func:`build_csr`
+    makes, term for term, so the result equals a fresh exact build.  The sources are
+    first gathered into ``(x, y, z, (k h)**2)`` records, one cache line per two
+    candidates.  ``scratch`` needs ``len(nbrs)`` entries.  Returns ``(offsets, nbrs)``."""
+    cdef const Grid* g = &grid.c
+    cdef Py_ssize_t nd = dest_h.shape[0], ns = src_h.shape[0], i, k, cnt, start
+    cdef const double* xd[3]
+    cdef const double* xs[3]
+    cdef const double* q
+    cdef double dx, dy, dz, r2, ri2, kh
+    cdef int a
+    cdef int* tmp = _iptr(scratch)
+    cdef int[::1] counts = np.empty(nd, dtype=np.int32)
+    cdef double[:, ::1] pts_view = np.zeros((max(ns, 1), 4), dtype=np.float64)
+    cdef double* pts = &pts_view[0, 0]
+    if offsets.shape[0] != nd + 1 or scratch.shape[0] < nbrs.shape[0]:
+        raise ValueError("refine_csr: the list does not fit the arrays")
+    for a in range(g.dim):
+        xd[a] = _coord_ptr(dest_coords[a], nd)
+        xs[a] = _coord_ptr(src_coords[a], ns)
+    for i in prange(ns, nogil=True, schedule="static"):
+        for a in range(g.dim):
+            pts[4 * i + a] = xs[a][i]
+        kh = radius_scale * src_h[i]
+        pts[4 * i + 3] = kh * kh
+    for i in prange(nd, nogil=True, schedule="static"):
+        start = offsets[i]
+        cnt = 0
+        kh = radius_scale * dest_h[i]
+        ri2 = kh * kh
+        for k in range(start, offsets[i + 1]):
+            q = pts + 4 * nbrs[k]      # (scalars, not a C array: those are shared in prange)
+            dx = xd[0][i] - q[0]
+            if g.periodic[0]:
+                dx = _min_image(g, 0, dx)
+            if g.dim == 1:
+                r2 = dx * dx
+            else:
+                dy = xd[1][i] - q[1]
+                if g.periodic[1]:
+                    dy = _min_image(g, 1, dy)
+                if g.dim == 2:
+                    r2 = dx * dx + dy * dy
+                else:
+                    dz = xd[2][i] - q[2]
+                    if g.periodic[2]:
+                        dz = _min_image(g, 2, dz)
+                    r2 = dx * dx + dy * dy + dz * dz
+            tmp[start + cnt] = nbrs[k]
+            cnt = cnt + (r2 < (ri2 if ri2 > q[3] else q[3]))
+        counts[i] = <int>cnt
+    new_off_arr = np.empty(nd + 1, dtype=np.int32)
+    cdef int[::1] new_off = new_off_arr
+    _prefix_sum(_iptr(counts), nd, new_off)
+    new_nbrs_arr = np.empty(new_off[nd], dtype=np.int32)
+    cdef int[::1] new_nbrs = new_nbrs_arr
+    cdef int* pn = _iptr(new_nbrs)
+    for i in prange(nd, nogil=True, schedule="static"):
+        if counts[i] > 0:
+            memcpy(pn + new_off[i], tmp + offsets[i], counts[i] * sizeof(int))
     return new_off_arr, new_nbrs_arr
