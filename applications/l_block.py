@@ -69,6 +69,8 @@ class LBlock(Application):
         group.add_argument("--form", choices=("E", "eta"), default="E", help="total energy or entropy")
         group.add_argument("--reduced", action="store_true",
                            help="the reduced {p, F, H, E} scheme (J = det F, no J equation)")
+        group.add_argument("--no-DJ", dest="dj", action="store_false",
+                           help="drop the J dissipation D_J (an ablation, docs/thermo.md)")
         group.add_argument("--no-projection", dest="projection", action="store_false",
                            help="switch the angular-momentum projection (eqs. 79-82) off")
         group.add_argument("--load", choices=("traction", "force"), default="traction",
@@ -118,7 +120,8 @@ class LBlock(Application):
     def create_scheme(self):
         o = self.options
         s = ThermoUpwindScheme(["body"], self.material, self.dx, hdx=o.hdx, kernel=o.kernel, form=o.form,
-                               jumps=o.jumps, projection=o.projection, cfl=o.cfl, reduced=o.reduced)
+                               jumps=o.jumps, projection=o.projection, cfl=o.cfl, reduced=o.reduced,
+                               dissipation=True if o.dj else "p")
         scale = 1.0 / (WIDTH * DEPTH) if o.load == "force" else 1.0
         T = o.load_time
 
@@ -159,7 +162,7 @@ class LBlock(Application):
     def history_meta(self):
         o = self.options
         return {"dx": self.dx, "jumps": o.jumps, "form": o.form, "projection": o.projection, "load": o.load,
-                "load_time": o.load_time, "reduced": o.reduced, "hdx": o.hdx, "kernel": o.kernel, "cfl": o.cfl,
+                "load_time": o.load_time, "reduced": o.reduced, "D_J": o.dj, "hdx": o.hdx, "kernel": o.kernel, "cfl": o.cfl,
                 "face_temperatures": list(o.face_temperatures)}
 
     def post_process(self, outdir):

@@ -196,7 +196,8 @@ class UpwindFluxes(Equation):
     """Pair sums of eqs. 54a-e (E-form) or 54a-d and 57 (eta-form), with the upwind
     dissipation D_p and D_J of eqs. 66/72 and coefficients 73-75, Ghavamian et al. (2021).
 
-    ``dissipation`` 0 switches the upwinding off; ``external`` 0 drops f_R, t_B, s_R, Q_B;
+    ``dissipation`` 0 switches the upwinding off, 2 keeps D_p only (an ablation: no D_J);
+    ``external`` 0 drops f_R, t_B, s_R, Q_B;
     ``reduced`` drops the J equation (J = det F).
     """
 
@@ -321,7 +322,7 @@ class UpwindFluxes(Equation):
                 f = 0.5 * rho * nC
                 for k in range(3):
                     d_tint[3 * d_idx + k] += f * (cp * jn * csk[k] + cs * used[k])
-                if not self.reduced:
+                if not self.reduced and self.dissipation == 1:
                     d_aJ[d_idx] += nc * nc / (2.0 * rho * cp * nC) * js
 
     def post_loop(self, d_idx, d_V, d_F, d_H, d_u, d_v, d_w, d_theta, d_Q, d_gradT, d_fb, d_sb,

@@ -312,7 +312,8 @@ class ThermoUpwindScheme(Scheme):
     ``jumps``: 'raw' (the paper's eqs. 66, 72) or 'limited' (limited linear
     reconstruction); ``projection``: the angular-momentum projection of eqs. 79-82;
     ``dt``: a fixed step instead of eq. 78 every step (it must respect eq. 78 at t = 0);
-    ``dissipation`` False drops the upwinding (for tests).  Essential conditions: a body
+    ``dissipation`` False drops the upwinding (for tests), ``"p"`` keeps D_p but drops
+    D_J (an ablation, docs/thermo.md).  Essential conditions: a body
     with a ``vfix`` property (3 flags per particle) gets its velocity components reset to
     ``vB`` (zero, or ``velocity(t, pa)``); one with ``tfix`` gets its temperature reset to
     ``thB`` (or ``temperature(t, pa)``).  ``add_load(body, f)`` adds a body force / heat
@@ -329,6 +330,8 @@ class ThermoUpwindScheme(Scheme):
             raise InputError(f"ThermoUpwindScheme: material must be a ThermoElasticMaterial, got {material!r}")
         if form not in FORMS:
             raise InputError(f"ThermoUpwindScheme: form {form!r} must be one of {', '.join(FORMS)}")
+        if dissipation not in (True, False, "p"):
+            raise InputError(f"ThermoUpwindScheme: dissipation {dissipation!r} must be True, False or 'p'")
         if jumps not in JUMPS:
             raise InputError(f"ThermoUpwindScheme: jumps {jumps!r} must be one of {', '.join(JUMPS)}")
         for name, v in (("dx", dx), ("hdx", hdx), ("cfl", cfl), ("dt", 1.0 if dt is None else dt)):
@@ -342,7 +345,8 @@ class ThermoUpwindScheme(Scheme):
         self.kernel_name = kernel
         self.kernel = get_kernel(kernel, 3)
         self.form, self.reduced, self.jumps = form, bool(reduced), jumps
-        self.projection, self.dissipation, self.cfl = bool(projection), bool(dissipation), float(cfl)
+        self.projection, self.cfl = bool(projection), float(cfl)
+        self.dissipation = 2 if dissipation == "p" else int(bool(dissipation))
         self.dt = None if dt is None else float(dt)
         self.adaptive_dt = (("dt_cfl",), self.cfl) if dt is None else None
         self.loads = []
@@ -422,7 +426,7 @@ class ThermoUpwindScheme(Scheme):
             ext = int(any(name == b for name, _ in self.loads))
             rates += [Group([EntropyVariableGradients(b, [b], form=form, reconstruct=rec)], reference=True),
                       Group([UpwindFluxes(b, [b], form=form, reconstruct=rec, reduced=int(self.reduced),
-                                          dissipation=int(self.dissipation), external=ext)],
+                                          dissipation=self.dissipation, external=ext)],
                             reference=True)]
             if self.projection:
                 rates.append(Group([AngularMomentumProjection(b)]))
