@@ -17,7 +17,6 @@ flow steady?), the fluid particles that left the cavity and the largest empty di
 the fluid (:func:`sphgen.tools.probes.largest_empty_disc`, in units of dx: the void of
 the paper's Fig. 13); ``profiles.png`` plots the profiles against Ghia's points.
 """
-import json
 import os
 
 import numpy as np
@@ -174,11 +173,7 @@ class Cavity(Application):
     # ------------------------------------------------------------ results
     def post_process(self, outdir):
         from sphgen.tools.probes import largest_empty_disc
-        with open(os.path.join(outdir, "history.json")) as fh:
-            hist = json.load(fh)
-        rows = np.array(hist["rows"], dtype=float)
-        if rows.size == 0:
-            raise InputError(f"{outdir}/history.json has no samples (run for at least one step)")
+        hist, rows = io.read_history(outdir)
         t, ke = rows[:, 0], rows[:, 1]
         ys, xs = np.array(hist["ghia_y"]), np.array(hist["ghia_x"])
         nu_, nv_ = ys.size, xs.size

@@ -31,7 +31,6 @@ Moyce (1952, a = 2.25 in and 1.125 in) and Koshizuka & Oka (1996) over 0.8 <= T 
 tank, and the energy balance (kinetic + potential + Tait internal energy); ``toe.png``
 and ``energy.png`` plot them.
 """
-import json
 import os
 from math import sqrt
 
@@ -205,11 +204,7 @@ class DamBreak2D(Application):
 
     # ------------------------------------------------------------ results
     def post_process(self, outdir):
-        with open(os.path.join(outdir, "history.json")) as fh:
-            hist = json.load(fh)
-        rows = np.array(hist["rows"], dtype=float)
-        if rows.size == 0:
-            raise InputError(f"{outdir}/history.json has no samples (run for at least one step)")
+        hist, rows = io.read_history(outdir)
         cols = {c: rows[:, i] for i, c in enumerate(hist["columns"])}
         T, Z = cols["T"], cols["toe"]
         ok = np.isfinite(Z)

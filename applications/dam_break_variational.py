@@ -232,11 +232,7 @@ class DamBreakVariational(Application):
 
     # ------------------------------------------------------------ results
     def post_process(self, outdir):
-        with open(os.path.join(outdir, "history.json")) as fh:
-            hist = json.load(fh)
-        rows = np.array(hist["rows"], dtype=float)
-        if rows.size == 0:
-            raise InputError(f"{outdir}/history.json has no samples (run for at least one step)")
+        hist, rows = io.read_history(outdir)
         cols = {c: rows[:, i] for i, c in enumerate(hist["columns"])}
         T, Z = cols["T"], cols["toe"]
         ok = np.isfinite(Z)

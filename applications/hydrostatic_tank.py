@@ -14,7 +14,6 @@ fluid pressure, :func:`sphgen.tools.probes.shepard`) relative to rho0 g H, the R
 speed relative to sqrt(g H), their histories, and the pressure along the vertical
 centre line against rho0 g (H - y); ``hydrostatic.png`` plots them.
 """
-import json
 import os
 from math import sqrt
 
@@ -119,11 +118,7 @@ class HydrostaticTank(Application):
                 float(np.sqrt(np.mean(speed ** 2))) / sqrt(G * H), float(speed.max()) / sqrt(G * H)]
 
     def post_process(self, outdir):
-        with open(os.path.join(outdir, "history.json")) as fh:
-            hist = json.load(fh)
-        rows = np.array(hist["rows"], dtype=float)
-        if rows.size == 0:
-            raise InputError(f"{outdir}/history.json has no samples (run for at least one step)")
+        hist, rows = io.read_history(outdir)
         t, prel, urms, umax = rows.T
         if self.scene is not None:
             f = self.scene.by_name["fluid"]

@@ -19,7 +19,6 @@ the same measurement for both integrators, whatever density they carry -- and th
 ``results.json``: energy error max |E - E0|/E0 and its drift, iteration statistics, and with
 ``--reference-run DIR`` the position error at the final time against that run (periodic images).
 """
-import json
 import os
 from math import pi
 
@@ -171,9 +170,7 @@ class LatticeVariational(Application):
 
     # ------------------------------------------------------------ results
     def post_process(self, outdir):
-        with open(os.path.join(outdir, "history.json")) as fh:
-            hist = json.load(fh)
-        rows = np.array(hist["rows"], dtype=float)
+        hist, rows = io.read_history(outdir, allow_empty=True)
         results = {k: hist.get(k) for k in ("integrator", "alpha", "tol", "density", "nx", "U", "time_step")}
         results.update(iteration_statistics(outdir))
         if rows.size:

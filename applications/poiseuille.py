@@ -16,7 +16,6 @@ reaches the steady parabola to 1e-4 u_max after t = 0.93 d^2/nu; the default fin
 the transient) relative to u_max at the final time, with the history of both;
 ``profile.png`` plots the profiles.
 """
-import json
 import os
 from math import pi
 
@@ -139,11 +138,7 @@ class ChannelFlow:
                 float(np.abs(um - self.steady(ym)).max() / UMAX), float(um[mid])]
 
     def post_process(self, outdir):
-        with open(os.path.join(outdir, "history.json")) as fh:
-            hist = json.load(fh)
-        rows = np.array(hist["rows"], dtype=float)
-        if rows.size == 0:
-            raise InputError(f"{outdir}/history.json has no samples (run for at least one step)")
+        hist, rows = io.read_history(outdir)
         t, dev_tr, dev_st, umid = rows.T
         if self.scene is not None:
             f = self.scene.by_name["fluid"]

@@ -23,7 +23,6 @@ relative to the exact field's norm.  ``python -m sphgen.applications.thermo_mms 
 32 40`` runs the levels and prints the least-squares orders.
 """
 import argparse
-import json
 import os
 import sys
 from math import pi

@@ -28,6 +28,7 @@ import xml.etree.ElementTree as ET
 import h5py
 import numpy as np
 
+from sphgen.errors import InputError
 from sphgen.particles import ParticleArray
 
 FORMAT = "sphgen-output"
@@ -125,6 +126,22 @@ def _write_array(parent, pa, opts):
 def write_json(path, obj):
     """Atomic JSON write; numpy scalars and arrays are converted."""
     _write_text(path, _dumps(obj, indent=2) + "\n")
+
+
+def read_history(outdir, allow_empty=False):
+    """``(history, rows)`` of a run folder's ``history.json``: the dict and its sample
+    rows as a float array (one row per sample, columns ``history["columns"]``).
+    A missing file, or one without samples unless ``allow_empty``, is an InputError."""
+    path = os.path.join(outdir, "history.json")
+    try:
+        with open(path) as fh:
+            hist = json.load(fh)
+    except (OSError, ValueError) as e:
+        raise InputError(f"{path}: cannot read the run's time series ({e})") from None
+    rows = np.array(hist.get("rows", []), dtype=float)
+    if rows.size == 0 and not allow_empty:
+        raise InputError(f"{path} has no samples (run for at least one step)")
+    return hist, rows
 
 
 # ------------------------------------------------------------------ loading
