@@ -4,6 +4,7 @@ import json
 import numpy as np
 import pytest
 
+from sphgen import io
 from sphgen.app import load_application
 from sphgen.tools import reference
 
@@ -36,14 +37,19 @@ def test_short_cavity_run_walls_hold_and_the_lid_drives_the_flow(tmp_path):
 
 @pytest.mark.parametrize("scheme", ["edac", "gtvf"])
 def test_baseline_schemes_run_the_cavity(tmp_path, scheme):
-    res, app = run_cavity(tmp_path, "--scheme", scheme, nx=10, tf=0.1)
+    perturb = ("--perturb", "0.2") if scheme == "edac" else ()
+    res, app = run_cavity(tmp_path, "--scheme", scheme, *perturb, nx=10, tf=0.1)
     assert res["scheme"] == scheme and res["n_outside_max"] == 0
     assert np.isfinite(res["max_dev"]) and max(res["u"]) > 0.1
+    x0 = io.load(io.output_files(str(tmp_path / "cavity"), "cavity")[0])["arrays"]["fluid"].x
+    off = np.abs(x0 * 10 - 0.5 - np.round(x0 * 10 - 0.5)).max()   # initial distance from the lattice, in dx
+    assert (0.1 < off <= 0.2) if perturb else off < 1e-9
 
 
 def test_cavity_rejects_bad_options(tmp_path):
     app = load_application("cavity")()
-    for args in (["--nx", "4"], ["--scheme", "gtvf", "--bql"], ["--scheme", "edac", "--no-corrections"]):
+    for args in (["--nx", "4"], ["--scheme", "gtvf", "--bql"], ["--scheme", "edac", "--no-corrections"],
+                 ["--perturb", "0.5"]):
         with pytest.raises(SystemExit):
             app.run(args + ["-d", str(tmp_path / "x")])
 
