@@ -19,7 +19,6 @@ the tear indicators (``void_fraction``: particles whose summation density fell b
 an elastic plate, whose strains stay below 1%).  Plots: centre.png, energy.png,
 pressure.png (the final state coloured by p).
 """
-import json
 import math
 import os
 
@@ -212,19 +211,15 @@ class BerylliumPlate(Application):
 
     def post_process(self, outdir):
         """results.json, centre.png, energy.png and pressure.png from the run's files."""
-        with open(os.path.join(outdir, "history.json")) as f:
-            hist = json.load(f)
-        rows = np.array(hist["rows"])
-        if rows.size == 0:
-            raise InputError("beryllium_plate: no history (a run of zero steps)")
+        hist, rows = io.read_history(outdir)
         t, yc, ek, eb, es, ep, et = rows.T
         drift = np.abs(et / et[0] - 1.0)
         if self.solver is not None:
-            pa, tf = self.scene.by_name["plate"], self.solver.t
+            pa = self.scene.by_name["plate"]
             state = {c: pa.get(c) for c in ("x", "y", "rho", "p")}
         else:
             last = io.load(io.output_files(outdir, self.name)[-1])
-            state, tf = last["arrays"]["plate"], last["solver_data"]["t"]
+            state = last["arrays"]["plate"]
         dr = hist["dr"]
         void, clump = tear_indicators(state["x"], state["y"], state["rho"], dr, hist["rho0"])
         period, how = measured_period(t, yc)
