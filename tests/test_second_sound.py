@@ -122,7 +122,8 @@ def test_entropy_error_below_one_percent_over_a_period(N, tmp_path):
     res = run(tmp_path, N, 50)[0]
     print(f"N = {N}, M = 50, A = 0.01: entropy error {res['entropy_error']:.4g} over a period, "
           f"{res['entropy_error_c1_window']:.4g} for t <= sqrt(2) L/c1; energy error {res['energy_error']:.3g}")
-    assert res["entropy_error_c1_window"] < 0.01, res
+    assert res["entropy_error_c1_window"] < 0.01, res     # holds: 0.70 % at N = 200
+    assert res["entropy_error"] < 0.01, res              # the claim over a full period
     assert res["entropy_error"] < 0.01, res
 
 
