@@ -31,7 +31,7 @@ from sphgen.particles import ParticleArray
 
 from ..equations.variational import kernel_parameters
 from ..schemes.variational import PREDICTORS, VariationalScheme
-from .dam_break_variational import STEP_COLUMNS, iteration_statistics, outputs_by_time, positions
+from .dam_break_variational import STEP_COLUMNS, iteration_statistics, position_error
 
 try:
     from sphgen.errors import InputError
@@ -182,29 +182,9 @@ class LatticeVariational(Application):
                             "energy_mean_second_half": float(rel[half].mean()),
                             "momentum_max": float(np.abs(rows[:, 4:6]).max())})
         if self.options.reference_run:
-            results.update(periodic_position_error(outdir, self.options.reference_run, self.L))
+            results.update(position_error(outdir, self.options.reference_run, period=self.L))
         io.write_json(os.path.join(outdir, "results.json"), results)
         print(f"lattice_variational: {results['integrator']} alpha={results['alpha']} dt={results['time_step']}: "
               f"energy error {results.get('energy_error')}, position error {results.get('position_error_max')}"
               f"\nresults: {os.path.join(outdir, 'results.json')}")
         return results
-
-
-def periodic_position_error(outdir, reference_dir, L):
-    """max and rms over the particles of |q_i - q_i^ref| (nearest periodic image) at the last
-    output time of ``outdir``, against ``reference_dir``'s output at the same time."""
-    last = io.output_files(outdir)[-1]
-    t = round(float(io.read_solver_data(last)["t"]), 9)
-    ref = outputs_by_time(reference_dir).get(t)
-    if ref is None:
-        raise InputError(f"--reference-run {reference_dir} has no output at t={t:g}")
-    g, x, y = positions(last)
-    gr, xr, yr = positions(ref)
-    if not np.array_equal(g, gr):
-        raise InputError(f"--reference-run {reference_dir} holds other particles")
-    dx, dy = x - xr, y - yr
-    dx -= L * np.round(dx / L)
-    dy -= L * np.round(dy / L)
-    e = np.hypot(dx, dy)
-    return {"position_error_max": float(e.max()), "position_error_rms": float(np.sqrt(np.mean(e * e))),
-            "reference_run": os.path.abspath(reference_dir)}
