@@ -486,5 +486,8 @@ def test_skin_rebuilds_at_once_for_a_large_jump_or_a_new_particle_count():
     nn.update()
     assert nn.n_builds == builds + 1               # one particle beyond half the skin
     assert_same_lists(nn.neighbours("f", "f"), brute_force(pa, pa, 2, 3.0))
+    pa.get("y")[5] = np.nan                        # a non-finite position is never skipped
+    with pytest.raises(ValueError, match="y"):
+        nn.update()
     with pytest.raises(ValueError, match="skin"):
         NeighbourSearch([pa], 2, 3.0, skin=-0.1)

@@ -235,10 +235,10 @@ class NeighbourSearch:
                 if dom.periodic[a]:
                     d -= dom.length[a] * np.round(d / dom.length[a])
                 d2 += d * d
-            moved2 = max(moved2, float(d2.max()))
-            dh = max(dh, float(np.abs(self._checked(pa, "h") - ref[-1]).max()))
-        if not (math.isfinite(moved2) and math.isfinite(dh)):
-            return False
+            m2, mh = float(d2.max()), float(np.abs(self._checked(pa, "h") - ref[-1]).max())
+            if not (math.isfinite(m2) and math.isfinite(mh)):
+                return False                  # (max() would pass a nan over)
+            moved2, dh = max(moved2, m2), max(dh, mh)
         return 2.0 * math.sqrt(moved2) + self.radius_scale * dh <= self.skin_distance
 
     def _build(self):
