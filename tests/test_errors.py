@@ -116,3 +116,13 @@ def test_bad_option_values(args, match, capsys):
     with pytest.raises(SystemExit) as e:
         main(["run", "taylor_green", "--disable-output"] + args)
     assert match in (capsys.readouterr().err + str(e.value.code))
+
+
+def test_python_dash_m_sphgen_answers_a_mistake_in_one_line():
+    """``python -m sphgen`` is the same command line as ``sphgen``."""
+    import subprocess
+    import sys
+    r = subprocess.run([sys.executable, "-m", "sphgen", "run", "taylor_green", "--nx", "0"],
+                       capture_output=True, text=True)
+    assert r.returncode == 2 and "Traceback" not in r.stderr
+    assert r.stderr.strip() == "sphgen: --nx must be at least 4, got 0"
