@@ -15,8 +15,10 @@ $(STAMP): setup.py pyproject.toml $(wildcard sphgen/nnps/*.pyx)
 run: $(STAMP)
 	$(VENV)/bin/sphgen run taylor_green --nx 50 --re 100 --tf 0.5 -d outputs/taylor_green --overwrite
 
+# two test processes, a test file per process (module-scoped scenes are built once); most
+# of a cold run is compiling generated modules, which this halves on two cores
 test: $(STAMP)
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n 2 --dist loadfile
 
 test-slow: $(STAMP)
 	$(PY) -m pytest -q -m slow

@@ -63,7 +63,7 @@ setup(
     ext_modules=cythonize(extensions, language_level=3),
     cmdclass={"build_ext": BuildExt},
     install_requires=["numpy>=2", "mako", "cython>=3", "compyle", "h5py", "automan",
-                      "pytest", "matplotlib", "tqdm", "setuptools"],
+                      "pytest", "pytest-xdist", "matplotlib", "tqdm", "setuptools"],
     entry_points={"console_scripts": ["sphgen = sphgen.app:main"]},
     zip_safe=False,
 )

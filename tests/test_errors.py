@@ -126,3 +126,14 @@ def test_python_dash_m_sphgen_answers_a_mistake_in_one_line():
                        capture_output=True, text=True)
     assert r.returncode == 2 and "Traceback" not in r.stderr
     assert r.stderr.strip() == "sphgen: --nx must be at least 4, got 0"
+
+
+def test_module_hash_ignores_where_the_project_lives():
+    """Two clones of the project generate the same code but different '# @src' paths: the
+    compile cache serves both; a different line (or code) is a different module."""
+    from sphgen.codegen.build import module_hash
+    src = "def f():\n    # @src {}/equations/basic.py:{}\n    return 1\n"
+    a = module_hash(src.format("/work/main", 12))
+    assert a == module_hash(src.format("/tmp/ci_clone", 12))
+    assert a != module_hash(src.format("/work/main", 13))
+    assert a != module_hash(src.format("/work/main", 12).replace("return 1", "return 2"))

@@ -77,9 +77,15 @@ CFLAGS = ["-O3", "-march=native", "-fno-math-errno", "-fno-trapping-math", "-ffp
           "-Wno-unreachable-code", "-Wno-maybe-uninitialized"]
 
 
+_SRC_PATH = re.compile(r"^(\s*# @src ).*?([^/\\]+:\d+)$", re.M)
+
+
 def module_hash(source):
+    """Hash of what the module is: the source with the ``# @src`` comments reduced to
+    ``file:line`` (two clones of the project share cached modules), compiler flags and
+    the versions the build depends on."""
     import Cython
-    key = "\n".join([source, " ".join(CFLAGS + openmp_flags()), Cython.__version__, numpy.__version__,
+    key = "\n".join([_SRC_PATH.sub(r"\1\2", source), " ".join(CFLAGS + openmp_flags()), Cython.__version__, numpy.__version__,
                      sys.version, platform.machine(), _cpu_model()])
     return hashlib.sha256(key.encode()).hexdigest()[:20]
 
