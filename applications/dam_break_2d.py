@@ -38,6 +38,7 @@ import numpy as np
 
 from sphgen import io
 from sphgen.app import Application
+from sphgen.kernels import get_kernel
 from sphgen.geometry import layers_for_support, rectangle, wall_layers_box
 from sphgen.particles import ParticleArray
 from sphgen.tools.probes import front_position
@@ -96,6 +97,9 @@ class DamBreak2D(Application):
         group.add_argument("--dx", type=float, default=0.03,
                            help="particle spacing, rounded so that L/dx is whole (default %(default)s)")
         group.add_argument("--hdx", type=float, default=1.0, help="h / dx (default %(default)s)")
+        group.add_argument("--kernel", choices=("quintic", "wendland"), default="quintic",
+                           help="kernel: quintic spline (support 3h) or Wendland C2 (support 2h; PySPH's "
+                                "dam_break_2d uses it with --hdx 1.3) (default %(default)s)")
         group.add_argument("--scheme", choices=("wcsph", "ctvf"), default="wcsph", help="scheme (default %(default)s)")
         group.add_argument("--alpha", type=float, default=None,
                            help="artificial viscosity (default 0.1 for wcsph, 0.05 for ctvf)")
@@ -120,6 +124,9 @@ class DamBreak2D(Application):
             v = getattr(o, name)
             if not (np.isfinite(v) and v > 0):
                 raise InputError(f"--{name.replace('_', '-')} must be a positive finite number, got {v}")
+        if o.scheme == "ctvf" and o.kernel != "quintic":
+            raise InputError("--scheme ctvf uses the quintic spline (its near-surface treatment is tied "
+                             "to it, Adepu & Ramachandran 2021 sec. 3.5); drop --kernel")
         if o.alpha is None:
             o.alpha = 0.05 if o.scheme == "ctvf" else 0.1
         if o.scheme == "ctvf":   # no equation of state: no internal energy to sample
@@ -132,7 +139,7 @@ class DamBreak2D(Application):
         self.dx = L / n
         self.h = o.hdx * self.dx
         self.c0 = o.c0_factor * sqrt(2.0 * G * H)
-        self.n_layers = layers_for_support(3.0, o.hdx)
+        self.n_layers = layers_for_support(get_kernel(o.kernel, 2), o.hdx)
         self.history = []
         self._next_record = 0.0
 
@@ -161,7 +168,7 @@ class DamBreak2D(Application):
                               walls=["wall"], free_surface=True, surface_pressure=o.surface_pressure)
         return WCSPHScheme(["fluid"], ["wall"], dim=2, rho0=RHO0, c0=self.c0, h=self.h, gy=-G,
                            alpha=o.alpha, beta=0.0, delta=o.delta, delta_correction=o.delta_correction,
-                           umax=sqrt(2.0 * G * H), wall_alpha=bool(o.wall_alpha))
+                           umax=sqrt(2.0 * G * H), wall_alpha=bool(o.wall_alpha), kernel=o.kernel)
 
     def history_meta(self):
         return {"dx": self.dx, "h": self.h, "c0": self.c0, "L": L, "m0": self.m0, "scheme": self.options.scheme}

@@ -31,6 +31,8 @@ from math import pow  # noqa: F401  (the Python evaluator needs the name)
 
 from sphgen.equation import Equation, helper
 
+from .wcsph import monaghan_pi
+
 TAIT, LINEAR = 0, 1
 EOS_NAMES = {"tait": TAIT, "linear": LINEAR}
 
@@ -268,8 +270,8 @@ class WallArtificialViscosity(Equation):
                     dw = dw - s_ww[s_idx]
             vr = du * XIJ[0] + dv * XIJ[1] + dw * XIJ[2]
             if vr < 0.0:
-                mu = HIJ * vr / (R2IJ + EPS)
-                pi = (-self.alpha * self.c0 * mu + self.beta * mu * mu) / (0.5 * (d_rho[d_idx] + s_rho[s_idx]))
+                pi = monaghan_pi(vr, HIJ, R2IJ + EPS, d_rho[d_idx] + s_rho[s_idx], self.alpha, self.beta,
+                                 self.c0)
                 f = -s_m[s_idx] * pi
                 d_au[d_idx] += f * DWIJ[0]
                 d_av[d_idx] += f * DWIJ[1]

@@ -8,7 +8,7 @@ The pressure-gradient term is :class:`sphgen.equations.momentum.PressureGradient
 """
 from math import fabs, pow, sin  # noqa: F401  (the Python evaluator needs the names)
 
-from sphgen.equation import Equation, declare
+from sphgen.equation import Equation, declare, helper
 from sphgen.linalg import inv3
 
 
@@ -118,6 +118,18 @@ class DensityDiffusion(Equation):
                 d_arho[d_idx] += self.delta * HIJ * self.c0 * psidw * vb
 
 
+@helper
+def monaghan_pi(vr=0.0, hij=1.0, r2eps=1.0, rho_sum=2.0, alpha=0.0, beta=0.0, c0=1.0):
+    """Pi_ab = (-alpha c0 mu + beta mu^2) / rho_ab, mu = h u_ab.r_ab / (r^2 + 0.01 h^2),
+    rho_ab = rho_sum / 2 (Monaghan 1992 eq. 4.1), with one division per pair."""
+    mu = hij * vr
+    inv = 1.0 / (r2eps * rho_sum)
+    pi = -2.0 * alpha * c0 * mu * inv
+    if beta != 0.0:
+        pi += 2.0 * beta * mu * mu * inv / r2eps
+    return pi
+
+
 class MonaghanArtificialViscosity(Equation):
     """du_a/dt -= sum_b m_b Pi_ab grad_a W_ab, Pi_ab = (-alpha c0 mu_ab + beta mu_ab^2)/rho_ab
     for u_ab . r_ab < 0, mu_ab = h u_ab . r_ab / (r^2 + 0.01 h^2), rho_ab the mean density
@@ -131,8 +143,8 @@ class MonaghanArtificialViscosity(Equation):
         if self.alpha != 0.0 or self.beta != 0.0:
             vr = VIJ[0] * XIJ[0] + VIJ[1] * XIJ[1] + VIJ[2] * XIJ[2]
             if vr < 0.0:
-                mu = HIJ * vr / (R2IJ + EPS)
-                pi = (-self.alpha * self.c0 * mu + self.beta * mu * mu) / (0.5 * (d_rho[d_idx] + s_rho[s_idx]))
+                pi = monaghan_pi(vr, HIJ, R2IJ + EPS, d_rho[d_idx] + s_rho[s_idx], self.alpha, self.beta,
+                                 self.c0)
                 f = -s_m[s_idx] * pi
                 d_au[d_idx] += f * DWIJ[0]
                 d_av[d_idx] += f * DWIJ[1]

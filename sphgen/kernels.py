@@ -15,7 +15,7 @@ class Kernel:
     radius_scale = 2.0
     name = "kernel"
     # translated into the scene module in this order (a method may call earlier ones)
-    methods = ("w", "dwdr", "gradh")
+    methods = ("w", "dwdr", "dwdr_over_r", "gradh")
     extra_methods = ()
 
     def __init__(self, dim):
@@ -33,6 +33,14 @@ class Kernel:
             s = s * hi
         return s
 
+    def dwdr_over_r(self, rij=1.0, h=1.0):
+        """(1/r) dW/dr, so that grad W = dwdr_over_r x_ij; 0 at r = 0 (a kernel with a closed
+        form that needs no division by r overrides this)."""
+        val = 0.0
+        if rij > 1e-12:
+            val = self.dwdr(rij, h) / rij
+        return val
+
     def constants(self):
         """Attributes folded into the generated code."""
         return {"dim": self.dim, "fac": self.fac}
@@ -46,7 +54,7 @@ class QuinticSpline(Kernel):
 
     radius_scale = 3.0
     name = "quintic"
-    methods = ("sigma", "w", "dwdr", "gradh")
+    methods = ("sigma", "w", "dwdr", "dwdr_over_r", "gradh")
     extra_methods = ("d2wdr2", "mixed")
 
     def __init__(self, dim):
@@ -118,7 +126,7 @@ class WendlandQuinticC2(Kernel):
 
     radius_scale = 2.0
     name = "wendland"
-    methods = ("sigma", "w", "dwdr", "gradh")
+    methods = ("sigma", "w", "dwdr", "dwdr_over_r", "gradh")
     extra_methods = ("mixed",)
 
     def __init__(self, dim):
@@ -142,6 +150,17 @@ class WendlandQuinticC2(Kernel):
             t = 1.0 - 0.5 * q
             val = -5.0 * q * t * t * t
         return self.sigma(h) * val / h
+
+    def dwdr_over_r(self, rij=1.0, h=1.0):
+        """(1/r) dW/dr = -5 a_d/h^(d+2) (1 - q/2)^3 for q < 2: smooth, no division by r (the q
+        of dW/dr cancels), so grad W = dwdr_over_r x_ij with one reciprocal of h per pair."""
+        hi = 1.0 / h
+        q = rij * hi
+        val = 0.0
+        if q < 2.0:
+            t = 1.0 - 0.5 * q
+            val = -5.0 * t * t * t
+        return self.sigma(h) * val * hi * hi
 
     def gradh(self, rij=1.0, h=1.0):
         """h dW/dh = -(d W + r dW/dr)."""

@@ -223,7 +223,7 @@ class Solver:
                              "[{elapsed}<{remaining}{postfix}]", leave=False, mininterval=0.5)
             self._bar.update(self.t)
         if self.guard:
-            self._pairs0 = {(d, s): n for d, s, n, _, _ in self.scene.nnps.busiest()}
+            self._pairs0 = self.scene.nnps.pair_totals()
             self._snapshot()
 
     def _finished(self):
@@ -308,7 +308,11 @@ class Solver:
         return None
 
     def _check_neighbours(self):
-        for d, s, pairs, i, count in self.scene.nnps.busiest():
+        totals = self.scene.nnps.pair_totals()
+        if not any(self._pairs0.get(key, 0) and n > self.neighbour_jump * self._pairs0[key]
+                   for key, n in totals.items()):
+            return None
+        for d, s, pairs, i, count in self.scene.nnps.busiest():   # only to say where
             start = self._pairs0.get((d, s))
             if start and pairs > self.neighbour_jump * start:
                 return (f"neighbour pairs {d}<-{s} jumped from {start} to {pairs} (particle {i} of "

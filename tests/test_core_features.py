@@ -221,3 +221,21 @@ def test_group_condition_and_update_nnps():
     sc.compute(0, 1.0, 0.01)                      # runs, then rebuilds the neighbour lists
     assert np.allclose((pa.x - x0) % 1.0, 0.01) and g.iterations == 1
     assert sc.nnps.n_updates == n0 + 1
+
+
+def test_check_finite_names_the_property_and_particle():
+    """The compiled guard (one sweep per array and stride, then per property) finds an inf
+    or a NaN in a scalar or a 3x3 property, and nothing in a finite state."""
+    pa = lattice_cloud(nx=6, dim=3, jitter=0.3, seed=5)
+    for p in ("L", "H", "gradv"):
+        pa.add_property(p, stride=9)
+    sc = Scene([pa], [RenormalisedVelocityGradient("fluid", ["fluid"])], dim=3,
+               outputs={"fluid": ["gradv"]})
+    sc.compute(0, 0.0, 0.1)
+    assert sc.check_finite() is None
+    for prop, k, bad in (("gradv", 9 * 17 + 4, np.inf), ("rho", 40, np.nan), ("x", 0, -np.inf)):
+        keep = pa.get(prop)[k]
+        pa.get(prop)[k] = bad
+        assert sc.check_finite() == ("fluid", prop, k // pa.props[prop].stride)
+        pa.get(prop)[k] = keep
+    assert sc.check_finite() is None

@@ -33,6 +33,17 @@ def test_derivatives_match_finite_differences(cls, dim):
     assert k.w(rs * h * (1 + 1e-12), h) == 0.0 and k.dwdr(rs * h * (1 + 1e-12), h) == 0.0
 
 
+@pytest.mark.parametrize("cls,dim", KINDS)
+def test_dwdr_over_r_times_r_is_dwdr(cls, dim):
+    """grad W = dwdr_over_r x_ij: the closed forms (Wendland: no division by r) agree with
+    dW/dr / r to round-off, vanish outside the support and give a zero gradient at r = 0."""
+    k = cls(dim)
+    h = 0.7
+    for r in np.linspace(1e-3, k.radius_scale * h * 1.01, 57):
+        assert abs(k.dwdr_over_r(r, h) * r - k.dwdr(r, h)) <= 1e-13 * abs(k.dwdr(0.5 * h, h))
+    assert np.isfinite(k.dwdr_over_r(0.0, h)) and 0.0 * k.dwdr_over_r(0.0, h) == 0.0
+
+
 def test_unknown_kernel_is_a_clear_error():
     with pytest.raises(ValueError, match="unknown kernel 'cubic'; known: quintic, wendland"):
         get_kernel("cubic", 2)

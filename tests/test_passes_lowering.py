@@ -75,8 +75,8 @@ def test_choose_pair_symbols_computes_what_the_loops_ask_for_and_its_inputs():
     plan = _plan([Viscous("fluid", ["fluid"], nu=0.1)], "choose_pair_symbols")
     notes = passes.choose_pair_symbols(plan)
     (loop,) = plan.neighbour_passes()[0].sources
-    assert loop.symbols == ("XIJ", "R2IJ", "RIJ", "HIJ", "EPS", "VIJ", "WDASHIJ", "DWIJ")
-    assert notes == ["g0_fluid <- fluid: XIJ, R2IJ, RIJ, HIJ, EPS, VIJ, WDASHIJ, DWIJ (~60 flops per pair)"]
+    assert loop.symbols == ("XIJ", "R2IJ", "RIJ", "HIJ", "EPS", "VIJ", "DWIJ")
+    assert notes == ["g0_fluid <- fluid: XIJ, R2IJ, RIJ, HIJ, EPS, VIJ, DWIJ (~60 flops per pair)"]
 
 
 def test_assign_registers_only_for_doubles_indexed_by_d_idx():
@@ -99,7 +99,7 @@ def test_collect_functions_orders_passes_then_stages_and_lists_parameters():
         "Viscous_0_initialize", "Viscous_0_loop", "Energy_1_initialize", "Kick_0_stage1"]
     assert [fp.origin for fp in plan.functions][-1] == "Kick.stage1"
     assert plan.parameters == {"Viscous_0_nu": (eqs[0].equations[0], "nu")}
-    assert [sp.fdef.name for sp in plan.kernel_functions] == ["kernel_sigma", "kernel_w", "kernel_dwdr",
+    assert [sp.fdef.name for sp in plan.kernel_functions] == ["kernel_sigma", "kernel_w", "kernel_dwdr", "kernel_dwdr_over_r",
                                                               "kernel_gradh"]
     assert notes == ["4 functions, 1 run-time parameters (Viscous_0_nu)"]
 

@@ -210,3 +210,15 @@ def test_largest_empty_disc_3d_and_bad_bounds():
     assert abs(r / dx - np.sqrt(3.0) / 2.0) < 1e-3
     with pytest.raises(ValueError, match="bounds"):
         probes.largest_empty_disc((x, y, z), (0.0, 1.0, 0.0, 1.0))
+
+
+@pytest.mark.parametrize("dim", [1, 2, 3])
+def test_count_neighbours_is_brute_force(dim):
+    """The cell-list count equals all-pairs distances (itself included), 1-3D."""
+    rng = np.random.default_rng(dim)
+    pts = tuple(rng.uniform(0, 1, 300) for _ in range(dim))
+    r = 0.17
+    X = np.column_stack(pts)
+    brute = (np.linalg.norm(X[:, None, :] - X[None, :, :], axis=2) < r).sum(axis=1)
+    assert np.array_equal(probes.count_neighbours(pts, r), brute)
+    assert probes.count_neighbours(tuple(np.empty(0) for _ in range(dim)), r).size == 0

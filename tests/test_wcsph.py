@@ -210,3 +210,17 @@ def test_hydrostatic_tank_full_run(tmp_path):
     assert res["t_over_sqrt_H_g"] == pytest.approx(10.0)
     assert abs(res["p_bottom_rel_error"]) < 0.02
     assert res["u_rms_over_sqrt_gH"] < 0.01
+
+
+def test_monaghan_pi_is_monaghan_1992_eq_4_1():
+    """One division per pair, the same Pi_ab = (-alpha c0 mu + beta mu^2) / rho_ab."""
+    from sphgen.equations.wcsph import monaghan_pi
+    rng = np.random.default_rng(3)
+    for _ in range(50):
+        vr, h, r2, eps = -rng.uniform(0, 2), rng.uniform(0.5, 1), rng.uniform(0.01, 4), 0.01
+        ra, rb, alpha, beta, c0 = rng.uniform(900, 1100, 2).tolist() + rng.uniform(0, 1, 2).tolist() + [30.0]
+        mu = h * vr / (r2 + eps)
+        ref = (-alpha * c0 * mu + beta * mu * mu) / (0.5 * (ra + rb))
+        for b in (beta, 0.0):
+            ref_b = ref if b == beta else -alpha * c0 * mu / (0.5 * (ra + rb))
+            assert abs(monaghan_pi(vr, h, r2 + eps, ra + rb, alpha, b, c0) - ref_b) <= 1e-13 * abs(ref_b)

@@ -136,7 +136,7 @@ def _vij_python(p):
 
 
 def _dwij_python(p):
-    f = p["WDASHIJ"] / p["RIJ"] if p["RIJ"] > 1e-12 else 0.0
+    f = p.kernel.dwdr_over_r(p["RIJ"], p["HIJ"])
     return [f * x for x in p["XIJ"]]
 
 
@@ -168,9 +168,9 @@ ROWS = (
     _kernel_row("GHIJ", "gradh", "h dW/dh at (r_ij, h_ij)", 60),
     _kernel_row("MIXEDIJ", "mixed", "(h/r) d2W/(dr dh) at (r_ij, h_ij): grad_i (h dW/dh) = MIXEDIJ x_ij",
                 40, extra=True),
-    PairSymbol("DWIJ", "grad_i W = W'(r_ij) x_ij / r_ij (0 at r = 0)", vector=True, cost=5,
-               depends=("WDASHIJ", "RIJ", "XIJ"), scratch=("_f",),
-               cython=lambda c: ["_f = WDASHIJ / RIJ if RIJ > 1e-12 else 0.0"] +
+    PairSymbol("DWIJ", "grad_i W = (W'(r_ij) / r_ij) x_ij (0 at r = 0), the kernel's dwdr_over_r",
+               vector=True, cost=35, depends=("RIJ", "HIJ", "XIJ"), scratch=("_f",),
+               cython=lambda c: ["_f = kernel_dwdr_over_r(RIJ, HIJ)"] +
                [f"DWIJ[{k}] = _f * XIJ[{k}]" for k in range(c.dim)],
                python=_dwij_python),
 )

@@ -115,7 +115,24 @@ def stage_${s.name}(double t, double dt):
 % endfor
 # ---------------------------------------------------------------- blow-up guard
 def count_nonfinite():
-    """[(array, property, count of non-finite values)], scanned in parallel."""
+    """[(array, property, count of non-finite values)]: one parallel sweep per array and
+    stride adds x * 0.0 of every value (NaN as soon as one is not finite); only then
+    is each property counted on its own."""
+    cdef long i
+    cdef double acc = 0.0
+% for arr, props in guarded:
+% for stride in sorted(set(st for _, st in props)):
+    with nogil:
+        for i in prange(${arr}_n * ${stride}, num_threads=_nthreads, schedule='static'):
+            acc += ${" + ".join(f"{arr}_{p}[i] * 0.0" for p, st in props if st == stride)}
+% endfor
+% endfor
+    if isfinite(acc):
+        return []
+    return _count_nonfinite_each()
+
+
+def _count_nonfinite_each():
     cdef long i
     cdef long bad
     out = []

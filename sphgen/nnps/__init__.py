@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from ._cell_list import (GridSpec, RowBuffers, bin_particles, build_csr, refine_csr, remap_csr,
+from ._cell_list import (GridSpec, RowBuffers, bin_particles, build_csr, largest_motion, refine_csr, remap_csr,
                          scan, wrap_periodic)
 
 __all__ = ["Domain", "NeighbourSearch", "NotFrozenError"]
@@ -220,24 +220,22 @@ class NeighbourSearch:
         """Wrap positions; True if no pair can have come within reach since the rebuild."""
         dom = self.domain
         moved2, dh = 0.0, 0.0
+        lengths = [dom.length[a] if dom.periodic[a] else 0.0 for a in range(self.dim)]
         for pa in self.arrays:
             ref = self._built_at[pa.name]
             if pa.n != self._sizes[pa.name]:
                 return False
             if not pa.n:
                 continue
-            d2 = np.zeros(pa.n)
+            coords = []
             for a in range(self.dim):
                 x = self._checked(pa, _AXES[a])
                 if dom.periodic[a] and wrap_periodic(x, dom.lo[a], dom.length[a]) >= 0:
                     return False              # non-finite: the rebuild names it
-                d = x - ref[a]
-                if dom.periodic[a]:
-                    d -= dom.length[a] * np.round(d / dom.length[a])
-                d2 += d * d
-            m2, mh = float(d2.max()), float(np.abs(self._checked(pa, "h") - ref[-1]).max())
+                coords.append(x)
+            m2, mh = largest_motion(coords, ref[:-1], self._checked(pa, "h"), ref[-1], lengths)
             if not (math.isfinite(m2) and math.isfinite(mh)):
-                return False                  # (max() would pass a nan over)
+                return False
             moved2, dh = max(moved2, m2), max(dh, mh)
         return 2.0 * math.sqrt(moved2) + self.radius_scale * dh <= self.skin_distance
 
@@ -341,6 +339,11 @@ class NeighbourSearch:
         self.n_cells = tuple(g_n)
 
     # ------------------------------------------------------------ queries
+    def pair_totals(self):
+        """{(dest, src): total pairs} of the lists built since the last update (cheap: one
+        read per list; the blow-up guard's per-step look)."""
+        return {key: int(off[-1]) for key, (off, _) in self._cache.items() if len(off) > 1}
+
     def busiest(self):
         """(dest, src, total pairs, particle with most neighbours, its count) over the lists
         built since the last update, one tuple per (dest, src); for the blow-up guard."""

@@ -35,7 +35,7 @@ minimum image, computed as ``(x_i - x_j) -/+ L`` like the usual formula); an axi
 with fewer cells visits every cell once and takes the minimum image pair by pair.
 """
 from cython.parallel cimport prange
-from libc.math cimport floor, isfinite
+from libc.math cimport fabs, floor, isfinite, round
 from libc.stdlib cimport free, malloc, realloc
 from libc.string cimport memcpy
 
@@ -608,6 +608,44 @@ def wrap_periodic(double[::1] x, double lo, double length):
                 v = lo
             x[i] = v
     return -1
+
+
+def largest_motion(list coords, list refs, double[::1] h, double[::1] h_ref, lengths):
+    """``(largest |x - x_ref|^2, largest |h - h_ref|)`` over the particles of one array;
+    ``lengths[a] > 0`` makes axis ``a`` periodic (minimum image).  NaN for both as soon
+    as a value is not finite (the caller then rebuilds, which names it)."""
+    cdef Py_ssize_t i, n = h.shape[0]
+    cdef int a, dim = len(coords)
+    cdef const double* x[3]
+    cdef const double* r[3]
+    cdef double L[3]
+    cdef double d, d2, m2 = 0.0, mh = 0.0
+    if h_ref.shape[0] != n or len(refs) != dim or dim > 3:
+        raise ValueError("largest_motion: the arrays do not match")
+    for a in range(dim):
+        x[a] = _coord_ptr(coords[a], n)
+        r[a] = _coord_ptr(refs[a], n)
+        L[a] = float(lengths[a])
+    with nogil:
+        for i in range(n):
+            d2 = 0.0
+            for a in range(dim):
+                d = x[a][i] - r[a][i]
+                if L[a] > 0.0:
+                    d = d - L[a] * round(d / L[a])
+                d2 = d2 + d * d
+            d = fabs(h[i] - h_ref[i])
+            if not (isfinite(d2) and isfinite(d)):
+                m2 = d2 + d          # NaN or inf: stop
+                mh = m2
+                break
+            if d2 > m2:
+                m2 = d2
+            if d > mh:
+                mh = d
+    if not (isfinite(m2) and isfinite(mh)):
+        return float("nan"), float("nan")
+    return m2, mh
 
 
 def scan(double[::1] x):

@@ -54,9 +54,17 @@ def kernel_values(kernel, r, h):
 
 
 def count_neighbours(positions, radius):
-    """Number of particles (itself included) closer than radius to each particle."""
-    i, _, _ = pairs_within(positions, positions, radius)
-    return np.bincount(i, minlength=np.size(positions[0]))
+    """Number of particles (itself included) closer than radius to each particle (the
+    compiled cell list of :mod:`sphgen.nnps`: a probe called every few steps of a run)."""
+    from sphgen.nnps import NeighbourSearch
+    from sphgen.particles import ParticleArray
+    coords = [np.array(c, dtype=float).ravel() for c in positions]
+    n = coords[0].size
+    if n == 0:
+        return np.zeros(0, dtype=np.int64)
+    pa = ParticleArray("probe", h=np.full(n, float(radius)), **dict(zip("xyz", coords)))
+    offsets = NeighbourSearch([pa], len(coords), 1.0, sort=False).neighbours("probe", "probe")[0]
+    return np.diff(offsets).astype(np.int64)
 
 
 # ------------------------------------------------------------------ interpolation
