@@ -831,6 +831,45 @@ def refine_csr(GridSpec grid, int[::1] offsets, int[::1] nbrs, list dest_coords,
             pts[4 * i + a] = xs[a][i]
         kh = radius_scale * src_h[i]
         pts[4 * i + 3] = kh * kh
+    cdef bint open2 = g.dim == 2 and not (g.periodic[0] or g.periodic[1])
+    cdef bint open3 = g.dim == 3 and not (g.periodic[0] or g.periodic[1] or g.periodic[2])
+    cdef double xi, yi, zi
+    if open2:     # the common cases without the per-candidate axis tests (same terms)
+        for i in prange(nd, nogil=True, schedule="static"):
+            start = offsets[i]
+            cnt = 0
+            kh = radius_scale * dest_h[i]
+            ri2 = kh * kh
+            xi = xd[0][i]
+            yi = xd[1][i]
+            for k in range(start, offsets[i + 1]):
+                q = pts + 4 * nbrs[k]
+                dx = xi - q[0]
+                dy = yi - q[1]
+                r2 = dx * dx + dy * dy
+                tmp[start + cnt] = nbrs[k]
+                cnt = cnt + (r2 < (ri2 if ri2 > q[3] else q[3]))
+            counts[i] = <int>cnt
+        return _compact(offsets, counts, tmp, nd)
+    if open3:
+        for i in prange(nd, nogil=True, schedule="static"):
+            start = offsets[i]
+            cnt = 0
+            kh = radius_scale * dest_h[i]
+            ri2 = kh * kh
+            xi = xd[0][i]
+            yi = xd[1][i]
+            zi = xd[2][i]
+            for k in range(start, offsets[i + 1]):
+                q = pts + 4 * nbrs[k]
+                dx = xi - q[0]
+                dy = yi - q[1]
+                dz = zi - q[2]
+                r2 = dx * dx + dy * dy + dz * dz
+                tmp[start + cnt] = nbrs[k]
+                cnt = cnt + (r2 < (ri2 if ri2 > q[3] else q[3]))
+            counts[i] = <int>cnt
+        return _compact(offsets, counts, tmp, nd)
     for i in prange(nd, nogil=True, schedule="static"):
         start = offsets[i]
         cnt = 0
@@ -857,6 +896,12 @@ def refine_csr(GridSpec grid, int[::1] offsets, int[::1] nbrs, list dest_coords,
             tmp[start + cnt] = nbrs[k]
             cnt = cnt + (r2 < (ri2 if ri2 > q[3] else q[3]))
         counts[i] = <int>cnt
+    return _compact(offsets, counts, tmp, nd)
+
+
+cdef tuple _compact(int[::1] offsets, int[::1] counts, int* tmp, Py_ssize_t nd):
+    """CSR lists of the first counts[i] entries of each row of tmp (rows at offsets)."""
+    cdef Py_ssize_t i
     new_off_arr = np.empty(nd + 1, dtype=np.int32)
     cdef int[::1] new_off = new_off_arr
     _prefix_sum(_iptr(counts), nd, new_off)
