@@ -17,10 +17,15 @@ class TaitEOS(Equation):
     eq. 3.3 with gamma = 7).  No sources."""
 
     positive = ("rho0", "c0", "gamma")
-
     def initialize(self, d_idx, d_rho, d_p):
         b = self.rho0 * self.c0 * self.c0 / self.gamma
-        d_p[d_idx] = b * (pow(d_rho[d_idx] / self.rho0, self.gamma) - 1.0)
+        x = d_rho[d_idx] / self.rho0
+        if self.gamma == 7.0:      # the usual case: four products instead of pow
+            x2 = x * x
+            xg = x2 * x2 * x2 * x
+        else:
+            xg = pow(x, self.gamma)
+        d_p[d_idx] = b * (xg - 1.0)
 
 
 class ContinuityEquation(Equation):
