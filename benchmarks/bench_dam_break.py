@@ -7,6 +7,11 @@ the time loop's wall time over (steps x all particles, fluid and wall); per flui
 particle-step too, since the codes lay different numbers of wall layers.  PySPH's steps
 are its time-step computations (profile_info.csv, minus the initial one).
 
+sphgen runs twice: with its defaults (quintic spline, support 3 dx, delta-SPH: three pair
+passes, ~2.5x the pairs of PySPH's case) and with PySPH's physics (``--delta 0 --kernel
+wendland --hdx 1.3``: plain WCSPH with the Wendland C2 kernel at h = 1.3 dx, as
+``pysph run dam_break_2d``).  The second is the same-case comparison.
+
     python benchmarks/bench_dam_break.py [--repeat 3] [--tf 0.7]
 """
 import argparse
@@ -24,10 +29,13 @@ from pysph_baseline import find_pysph_python  # noqa: E402
 SPHGEN = os.path.join(os.path.dirname(sys.executable), "sphgen")
 
 
-def sphgen_run(work, tf, threads):
-    out = os.path.join(work, f"sphgen_t{threads}")
+CONFIGS = {"sphgen": [], "sphgen-pysph-physics": ["--delta", "0", "--kernel", "wendland", "--hdx", "1.3"]}
+
+
+def sphgen_run(work, tf, threads, config="sphgen"):
+    out = os.path.join(work, f"{config}_t{threads}")
     cmd = [SPHGEN, "run", "dam_break_2d", "--tf", str(tf), "--disable-output", "--no-progress",
-           "--overwrite", "-d", out]
+           "--overwrite", "-d", out] + CONFIGS[config]
     cmd += ["--no-openmp"] if threads == 1 else ["--threads", str(threads)]
     subprocess.run(cmd, check=True, capture_output=True, env=dict(os.environ, SPHGEN_TUNE_THREADS="0"))
     info = json.load(open(os.path.join(out, "info.json")))
@@ -61,16 +69,19 @@ def main():
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--tf", type=float, default=0.7)
     a = ap.parse_args()
+    print(f"load average before: {os.getloadavg()[0]:.2f}")
     py = find_pysph_python()
     work = tempfile.mkdtemp(prefix="sphgen_db_")
-    sphgen_run(work, 0.001, 1)  # compile once
+    for config in CONFIGS:
+        sphgen_run(work, 0.001, 1, config)  # compile once
     if py:
         pysph_run(py, work, 0.001, 1)
         pysph_run(py, work, 0.001, 2)
     res = {}
     for _ in range(a.repeat):
         for threads in (1, 2):
-            res.setdefault(("sphgen", threads), []).append(sphgen_run(work, a.tf, threads))
+            for config in CONFIGS:
+                res.setdefault((config, threads), []).append(sphgen_run(work, a.tf, threads, config))
             if py:
                 res.setdefault(("pysph", threads), []).append(pysph_run(py, work, a.tf, threads))
     us = {}
@@ -80,14 +91,20 @@ def main():
         t_fs = statistics.median(x["wall"] / (x["steps"] * x["fluid"]) for x in rows) * 1e6
         us[(code, threads)] = (t_ps, t_fs)
         pairs = f", {med(rows, 'pairs_per_s'):.3g} neighbour pairs/s" if "pairs_per_s" in r else ""
-        print(f"{code:6s} {threads} thread(s): {r['fluid']} fluid + {r['n'] - r['fluid']} wall, "
+        print(f"{code:20s} {threads} thread(s): {r['fluid']} fluid + {r['n'] - r['fluid']} wall, "
               f"{r['steps']} steps, {med(rows, 'wall'):.2f} s, {t_ps:.3f} us/particle-step, "
               f"{t_fs:.3f} us/fluid-particle-step{pairs}")
-    for threads in (1, 2):
-        if ("pysph", threads) in us:
-            p, s = us[("pysph", threads)], us[("sphgen", threads)]
-            print(f"PySPH / sphgen, {threads} thread(s): {p[0] / s[0]:.2f}x per particle-step, "
-                  f"{p[1] / s[1]:.2f}x per fluid particle-step")
+    for config in CONFIGS:
+        s1, s2 = us[(config, 1)], us[(config, 2)]
+        print(f"{config}: 1 -> 2 threads {s1[0] / s2[0]:.2f}x")
+        for threads in (1, 2):
+            if ("pysph", threads) in us:
+                p, s = us[("pysph", threads)], us[(config, threads)]
+                print(f"PySPH / {config}, {threads} thread(s): {p[0] / s[0]:.2f}x per particle-step, "
+                      f"{p[1] / s[1]:.2f}x per fluid particle-step")
+
+
+    print(f"load average after: {os.getloadavg()[0]:.2f}")
 
 
 if __name__ == "__main__":

@@ -118,17 +118,29 @@ class Solver:
         self.scene.update_nnps()
 
     def _snapshot(self):
-        if self._good is None:
-            self._good = {(pa.name, k): np.empty_like(v) for pa in self.scene.arrays for k, v in pa.data.items()}
+        """Copy every array's data into one buffer per dtype (a concatenate each: the guard
+        runs every step, so this is a few numpy calls, not one per property)."""
+        groups = {}
         for pa in self.scene.arrays:
             for k, v in pa.data.items():
-                np.copyto(self._good[(pa.name, k)], v)
+                groups.setdefault(v.dtype, []).append(v)
+        layout = [(dt, [v.size for v in vs]) for dt, vs in groups.items()]
+        if self._good is None or self._good[0] != layout:
+            self._good = (layout, [np.empty(sum(sizes), dtype=dt) for dt, sizes in layout])
+        for vs, buf in zip(groups.values(), self._good[1]):
+            np.concatenate([v.ravel() for v in vs], out=buf)
         self._good_t, self._good_step = self.t, self.step
 
     def _restore_snapshot(self):
+        groups = {}
         for pa in self.scene.arrays:
-            for k, v in pa.data.items():
-                np.copyto(v, self._good[(pa.name, k)])
+            for v in pa.data.values():
+                groups.setdefault(v.dtype, []).append(v)
+        for vs, buf in zip(groups.values(), self._good[1]):
+            start = 0
+            for v in vs:
+                v.ravel()[:] = buf[start:start + v.size]
+                start += v.size
         self.t, self.step = self._good_t, self._good_step
 
     def write_output(self, path=None):
