@@ -269,13 +269,11 @@ class WallArtificialViscosity(Equation):
                 if self.dim > 2:
                     dw = dw - s_ww[s_idx]
             vr = du * XIJ[0] + dv * XIJ[1] + dw * XIJ[2]
-            if vr < 0.0:
-                pi = monaghan_pi(vr, HIJ, R2IJ + EPS, d_rho[d_idx] + s_rho[s_idx], self.alpha, self.beta,
-                                 self.c0)
-                f = -s_m[s_idx] * pi
-                d_au[d_idx] += f * DWIJ[0]
-                d_av[d_idx] += f * DWIJ[1]
-                d_aw[d_idx] += f * DWIJ[2]
+            pi = monaghan_pi(vr, HIJ, R2IJ + EPS, d_rho[d_idx] + s_rho[s_idx], self.alpha, self.beta, self.c0)
+            f = -s_m[s_idx] * pi
+            d_au[d_idx] += f * DWIJ[0]
+            d_av[d_idx] += f * DWIJ[1]
+            d_aw[d_idx] += f * DWIJ[2]
 
 
 class WallEDACPressureRate(Equation):

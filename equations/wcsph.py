@@ -125,9 +125,10 @@ class DensityDiffusion(Equation):
 
 @helper
 def monaghan_pi(vr=0.0, hij=1.0, r2eps=1.0, rho_sum=2.0, alpha=0.0, beta=0.0, c0=1.0):
-    """Pi_ab = (-alpha c0 mu + beta mu^2) / rho_ab, mu = h u_ab.r_ab / (r^2 + 0.01 h^2),
-    rho_ab = rho_sum / 2 (Monaghan 1992 eq. 4.1), with one division per pair."""
-    mu = hij * vr
+    """Pi_ab = (-alpha c0 mu + beta mu^2) / rho_ab for approaching pairs (vr = u_ab.r_ab < 0),
+    0 otherwise; mu = h vr / (r^2 + 0.01 h^2), rho_ab = rho_sum / 2 (Monaghan 1992 eq. 4.1).
+    One division and no branch per pair: min(vr, 0) is 0.5 (vr - |vr|), exactly."""
+    mu = hij * 0.5 * (vr - fabs(vr))
     inv = 1.0 / (r2eps * rho_sum)
     pi = -2.0 * alpha * c0 * mu * inv
     if beta != 0.0:
@@ -147,13 +148,12 @@ class MonaghanArtificialViscosity(Equation):
     def loop(self, d_idx, d_au, d_av, d_aw, d_rho, s_idx, s_m, s_rho, XIJ, VIJ, DWIJ, R2IJ, HIJ, EPS):
         if self.alpha != 0.0 or self.beta != 0.0:
             vr = VIJ[0] * XIJ[0] + VIJ[1] * XIJ[1] + VIJ[2] * XIJ[2]
-            if vr < 0.0:
-                pi = monaghan_pi(vr, HIJ, R2IJ + EPS, d_rho[d_idx] + s_rho[s_idx], self.alpha, self.beta,
-                                 self.c0)
-                f = -s_m[s_idx] * pi
-                d_au[d_idx] += f * DWIJ[0]
-                d_av[d_idx] += f * DWIJ[1]
-                d_aw[d_idx] += f * DWIJ[2]
+            pi = monaghan_pi(vr, HIJ, R2IJ + EPS, d_rho[d_idx] + s_rho[s_idx], self.alpha, self.beta,
+                             self.c0)
+            f = -s_m[s_idx] * pi
+            d_au[d_idx] += f * DWIJ[0]
+            d_av[d_idx] += f * DWIJ[1]
+            d_aw[d_idx] += f * DWIJ[2]
 
 
 class BodyForce(Equation):

@@ -213,7 +213,8 @@ def test_hydrostatic_tank_full_run(tmp_path):
 
 
 def test_monaghan_pi_is_monaghan_1992_eq_4_1():
-    """One division per pair, the same Pi_ab = (-alpha c0 mu + beta mu^2) / rho_ab."""
+    """One division and no branch per pair, the same Pi_ab = (-alpha c0 mu + beta mu^2) / rho_ab
+    for approaching pairs and 0 for receding ones."""
     from sphgen.equations.wcsph import monaghan_pi
     rng = np.random.default_rng(3)
     for _ in range(50):
@@ -224,3 +225,4 @@ def test_monaghan_pi_is_monaghan_1992_eq_4_1():
         for b in (beta, 0.0):
             ref_b = ref if b == beta else -alpha * c0 * mu / (0.5 * (ra + rb))
             assert abs(monaghan_pi(vr, h, r2 + eps, ra + rb, alpha, b, c0) - ref_b) <= 1e-13 * abs(ref_b)
+            assert monaghan_pi(-vr, h, r2 + eps, ra + rb, alpha, b, c0) == 0.0     # receding: none
