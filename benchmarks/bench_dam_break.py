@@ -25,6 +25,7 @@ import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from pysph_baseline import find_pysph_python  # noqa: E402
+from roofline import peak_gflops, roofline_line  # noqa: E402
 
 SPHGEN = os.path.join(os.path.dirname(sys.executable), "sphgen")
 
@@ -41,7 +42,7 @@ def sphgen_run(work, tf, threads, config="sphgen"):
     info = json.load(open(os.path.join(out, "info.json")))
     n, steps, wall = info["n_particles"], info["steps"], info["wall_time"]
     return {"wall": wall, "steps": steps, "n": n, "fluid": info["particles"]["fluid"],
-            "pairs_per_s": info["neighbour_pairs_per_step"] * steps / wall}
+            "pairs_per_s": info["neighbour_pairs_per_step"] * steps / wall, "info": info}
 
 
 def pysph_run(py, work, tf, threads):
@@ -94,6 +95,11 @@ def main():
         print(f"{code:20s} {threads} thread(s): {r['fluid']} fluid + {r['n'] - r['fluid']} wall, "
               f"{r['steps']} steps, {med(rows, 'wall'):.2f} s, {t_ps:.3f} us/particle-step, "
               f"{t_fs:.3f} us/fluid-particle-step{pairs}")
+    peak = peak_gflops()
+    for config in CONFIGS:
+        for threads in (1, 2):
+            rows = sorted(res[(config, threads)], key=lambda x: x["wall"])
+            print(roofline_line(rows[len(rows) // 2]["info"], peak, f"{config}, {threads} thread(s)"))
     for config in CONFIGS:
         s1, s2 = us[(config, 1)], us[(config, 2)]
         print(f"{config}: 1 -> 2 threads {s1[0] / s2[0]:.2f}x")

@@ -21,6 +21,7 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from pysph_baseline import _busy_cpu_seconds, find_pysph_python, run_pysph  # noqa: E402
+from roofline import peak_gflops, roofline_line  # noqa: E402
 
 
 def run_sphgen(nx, tf, threads, workdir, cache=None):
@@ -97,6 +98,9 @@ def main(argv=None):
                              "other_cpu_s": [round(r["other_cpu_s"] or 0, 2) for r in ok]}
         res[f"ratio_{t}"] = res[f"pysph_{t}"]["us_per_particle_step"] / res[f"sphgen_{t}"]["us_per_particle_step"]
     res["load_end"] = os.getloadavg()[0]
+    peak = peak_gflops()
+    res["roofline"] = [roofline_line(sorted(ours[t], key=lambda r: r["wall_time"])[len(ours[t]) // 2], peak,
+                                     f"sphgen {t} thread(s)") for t in (1, 2)]
 
     print(f"Taylor-Green EDAC nx={o.nx} ({o.nx * o.nx} particles), tf={o.tf}, medians of {o.repeat}")
     print(f"{'':24s}{'us/particle-step':>18s}{'pairs/s':>12s}{'wall s':>9s}  other-CPU s")
@@ -114,6 +118,8 @@ def main(argv=None):
         if f"ratio_{t}" in res:
             print(f"PySPH / sphgen time per particle-step, {t} thread(s): {res[f'ratio_{t}']:.2f}x")
     print(f"sphgen first-run compile time: {res['sphgen_compile_s']:.2f} s")
+    for line in res["roofline"]:
+        print(line)
     print(f"load average: {res['load_start']:.2f} at start, {res['load_end']:.2f} at end")
     if o.json:
         with open(o.json, "w") as f:

@@ -287,8 +287,11 @@ class Application:
                 "kernel": type(kernel).__name__ if kernel is not None else None,
                 "dim": self.dim, "sphgen_version": __version__}
 
-    def neighbour_pairs_per_step(self):
-        """Neighbour pairs visited in one step (all evaluations and passes)."""
+    def neighbour_pairs_per_step(self, flops=False):
+        """Neighbour pairs visited in one step (all evaluations and passes); with
+        ``flops``, the estimated floating-point operations they cost
+        (:func:`sphgen.codegen.describe.loop_flops`)."""
+        from .codegen.describe import loop_flops
         plan = self.scene.plan
         n_eval = self.solver.integrator.n_evaluations
         rows = plan.group_plans
@@ -296,11 +299,12 @@ class Application:
         for k in range(n_eval):
             row = rows[k] if len(rows) > 1 else rows[0]
             for gp in row:
-                for dest in gp.dests:
-                    for src in gp.sources(dest):
-                        off, _ = (self.scene.nnps.reference_neighbours(dest, src) if gp.group.reference
-                                  else self.scene.nnps.neighbours(dest, src))
-                        total += int(off[-1]) * max(1, gp.group.iterations)
+                for dest, npass in gp.passes.items():
+                    for loop in npass.sources:
+                        off, _ = (self.scene.nnps.reference_neighbours(dest, loop.source) if gp.group.reference
+                                  else self.scene.nnps.neighbours(dest, loop.source))
+                        pairs = int(off[-1]) * max(1, gp.group.iterations)
+                        total += pairs * (loop_flops(npass, loop) if flops else 1)
         return total
 
     def _info(self, completed, error=None):
@@ -315,6 +319,7 @@ class Application:
             "thread_choices": s.tuner.choices if s.tuner else [],
             "time_per_particle_step": s.wall_time / (steps * max(n, 1)),
             "neighbour_pairs_per_step": self.neighbour_pairs_per_step() if completed else None,
+            "estimated_pair_flops_per_step": self.neighbour_pairs_per_step(flops=True) if completed else None,
             "neighbour_updates": sc.nnps.n_updates, "neighbour_builds": sc.nnps.n_builds,
             "generated_source": getattr(sc, "source_path", None),
             "restarts": self.restarts, "options": vars(opts),

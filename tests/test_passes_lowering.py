@@ -123,3 +123,17 @@ def test_collect_helpers_translates_each_helper_once_callees_first():
     with pytest.raises(TranslationError, match=r"Bad\.initialize: not_a_helper\(\) is a Python function, "
                                                r"not a sphgen helper"):
         passes.collect_helpers(plan)
+
+
+def test_loop_flops_is_the_symbols_cost_plus_the_loop_arithmetic():
+    """The roofline estimate: pair-symbol costs plus +, -, *, / of the loop methods."""
+    import ast
+    from sphgen.codegen import pair_symbols
+    from sphgen.codegen.describe import _arithmetic_ops, loop_flops
+    fdef = ast.parse("def f(a, b):\n    a[0] += 2.0 * b / (b - 1.0)\n    c = -b\n    return sqrt(c)\n").body[0]
+    assert _arithmetic_ops(fdef) == 4            # +=, *, /, - (unary minus and calls not counted)
+    plan = _plan([Viscous("fluid", ["fluid"], nu=0.1)], "choose_pair_symbols")
+    passes.choose_pair_symbols(plan)
+    npass = plan.neighbour_passes()[0]
+    (loop,) = npass.sources
+    assert loop_flops(npass, loop) > pair_symbols.cost(loop.symbols)

@@ -1,4 +1,24 @@
-"""``--show-plan``: the plan as text, then what each pass removed or decided."""
+"""``--show-plan``: the plan as text, then what each pass removed or decided; the plan's
+estimated floating-point work per neighbour pair (for the benchmarks' roofline line)."""
+import ast
+
+from . import pair_symbols
+
+_ARITHMETIC = (ast.Add, ast.Sub, ast.Mult, ast.Div)
+
+
+def _arithmetic_ops(fdef):
+    """+, -, *, / in a specialised method (augmented assignments included; calls of
+    helpers and math functions not counted)."""
+    return sum(isinstance(n, (ast.BinOp, ast.AugAssign)) and isinstance(n.op, _ARITHMETIC)
+               for n in ast.walk(fdef))
+
+
+def loop_flops(npass, loop):
+    """Estimated flops per pair of one source loop of a neighbour pass: its pair symbols
+    (the table's costs) plus the arithmetic of the loop methods it calls."""
+    return pair_symbols.cost(loop.symbols) + sum(
+        _arithmetic_ops(npass.spec(ep, "loop").fdef) for ep in loop.calls("loop"))
 
 
 def _flags(group):

@@ -1,0 +1,109 @@
+"""The machine's limits, for the benchmarks' roofline line: peak FMA rate and a triad.
+
+Peak: 10 independent chains of fused multiply-adds, one core, compiled with the flags of
+the generated modules (``sphgen.codegen.build``: ``-O3 -march=native``): scalar doubles,
+and arrays of 4 doubles per chain that gcc turns into one AVX2 register each.  Triad:
+``a = b + s c`` with numpy on arrays far larger than the caches (two passes: numpy
+makes ``s c`` first), in GB/s of the three streams.  ``roofline_line`` turns a run's
+``info.json`` (estimated pair flops per step, steps, wall time, threads) into the
+distance to the peak.
+
+    python benchmarks/roofline.py            # prints the machine's numbers
+"""
+import time
+
+import numpy as np
+
+_SOURCE = '''
+# cython: boundscheck=False, wraparound=False, cdivision=True
+def fma_scalar(long n):
+    """2 flops x 10 chains per iteration, scalar doubles."""
+    cdef double a0 = 1.0, a1 = 1.1, a2 = 1.2, a3 = 1.3, a4 = 1.4
+    cdef double a5 = 1.5, a6 = 1.6, a7 = 1.7, a8 = 1.8, a9 = 1.9
+    cdef double m = 0.999999, c = 1e-7
+    cdef long i
+    for i in range(n):
+        a0 = a0 * m + c
+        a1 = a1 * m + c
+        a2 = a2 * m + c
+        a3 = a3 * m + c
+        a4 = a4 * m + c
+        a5 = a5 * m + c
+        a6 = a6 * m + c
+        a7 = a7 * m + c
+        a8 = a8 * m + c
+        a9 = a9 * m + c
+    return a0 + a1 + a2 + a3 + a4 + a5 + a6 + a7 + a8 + a9
+
+
+def fma_vector(long n):
+    """2 flops x 40 lanes (10 chains of 4 doubles) per iteration."""
+    cdef double a[40]
+    cdef double m = 0.999999, c = 1e-7, s = 0.0
+    cdef long i
+    cdef int k
+    for k in range(40):
+        a[k] = 1.0 + 0.01 * k
+    for i in range(n):
+        for k in range(40):
+            a[k] = a[k] * m + c
+    for k in range(40):
+        s += a[k]
+    return s
+'''
+
+
+def _module():
+    from sphgen.codegen.build import load_or_build
+    return load_or_build(_SOURCE)[0]
+
+
+def peak_gflops(repeat=5, n=20_000_000):
+    """{'scalar': GFLOP/s, 'avx': GFLOP/s} of one core: the best of ``repeat`` runs."""
+    mod = _module()
+    out = {}
+    for name, fn, flops in (("scalar", mod.fma_scalar, 20), ("avx", mod.fma_vector, 80)):
+        m = n if name == "scalar" else n // 4
+        best = min(_timed(fn, m) for _ in range(repeat))
+        out[name] = flops * m / best / 1e9
+    return out
+
+
+def _timed(fn, n):
+    t0 = time.perf_counter()
+    fn(n)
+    return time.perf_counter() - t0
+
+
+def triad_gbs(n=20_000_000, repeat=5):
+    """numpy a = b + s c: GB/s counting the three arrays once (best of ``repeat``)."""
+    b, c = np.random.rand(n), np.random.rand(n)
+    a = np.empty(n)
+    best = np.inf
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        np.multiply(c, 3.0, out=a)
+        np.add(a, b, out=a)
+        best = min(best, time.perf_counter() - t0)
+    return 3 * 8 * n / best / 1e9
+
+
+def roofline_line(info, peak, label=""):
+    """One line: pairs per second per core, estimated GFLOP/s per core, % of the peaks."""
+    flops, pairs = info.get("estimated_pair_flops_per_step"), info.get("neighbour_pairs_per_step")
+    if not flops or not pairs:
+        return f"roofline {label}: no flop estimate in info.json"
+    threads = max(1, int(info.get("threads") or 1))
+    seconds = info["wall_time"] * threads
+    pps = pairs * info["steps"] / seconds
+    gf = flops * info["steps"] / seconds / 1e9
+    return (f"roofline {label}: {pps:.3g} pairs/s per core, ~{flops / pairs:.0f} flops per pair "
+            f"(generator's estimate), {gf:.2f} GFLOP/s per core = {100 * gf / peak['scalar']:.0f} % of "
+            f"the scalar FMA peak ({peak['scalar']:.1f}), {100 * gf / peak['avx']:.0f} % of the AVX2 "
+            f"peak ({peak['avx']:.1f}); pair passes and everything around them included")
+
+
+if __name__ == "__main__":
+    p = peak_gflops()
+    print(f"peak, one core: scalar FMA {p['scalar']:.1f} GFLOP/s, AVX2 FMA {p['avx']:.1f} GFLOP/s; "
+          f"numpy triad {triad_gbs():.1f} GB/s")
