@@ -236,27 +236,36 @@ def dam(args):
     return app
 
 
-@pytest.mark.parametrize("integrator", ["variational", "explicit"])
-def test_restart_is_bit_for_bit(tmp_path, integrator):
-    """A run restarted from its output of step 10 ends with the same files, bit for bit,
-    and the same time series (the start-up step is not taken again)."""
+def restart_matches_full_run(app, run, tmp_path):
+    """Run ``app`` (dam or lattice) with ``run`` to the end and again restarted from its output of
+    step 10: the same final state and time series (history.json, steps.json), bit for bit.
+    Returns (the restart file, the rows of history.json and of steps.json)."""
     import json
     from sphgen import io
-    run = ["--integrator", integrator, "--tf", "0.002", "--pfreq", "10", "--record-every", "3e-4"]
-    dam(run + ["-d", str(tmp_path / "full")])
+    app(run + ["-d", str(tmp_path / "full")])
     mid = io.output_files(tmp_path / "full")[1]
     assert io.step_of(mid) == 10
-    dam(run + ["-d", str(tmp_path / "part"), "--restart", mid])
+    app(run + ["-d", str(tmp_path / "part"), "--restart", mid])
     a = io.load(io.output_files(tmp_path / "full")[-1])["arrays"]["fluid"]
     b = io.load(io.output_files(tmp_path / "part")[-1])["arrays"]["fluid"]
-    assert np.abs(a.y - io.load(mid)["arrays"]["fluid"].y).max() > 1e-6
     for p in a.data:
         assert np.array_equal(a.data[p], b.data[p]), p
+    rows = {}
     for name in ("history.json", "steps.json"):
         ra = json.load(open(tmp_path / "full" / name))["rows"]
         rb = json.load(open(tmp_path / "part" / name))["rows"]
         assert json.dumps(ra) == json.dumps(rb), name
-    steps = json.load(open(tmp_path / "full" / "steps.json"))["rows"]
+        rows[name] = ra
+    assert np.abs(a.y - io.load(mid)["arrays"]["fluid"].y).max() > 1e-6
+    return mid, rows["history.json"], rows["steps.json"]
+
+
+@pytest.mark.parametrize("integrator", ["variational", "explicit"])
+def test_restart_is_bit_for_bit(tmp_path, integrator):
+    """A run restarted from its output of step 10 ends with the same files, bit for bit,
+    and the same time series (the start-up step is not taken again)."""
+    run = ["--integrator", integrator, "--tf", "0.002", "--pfreq", "10", "--record-every", "3e-4"]
+    _, _, steps = restart_matches_full_run(dam, run, tmp_path)
     assert len(steps) == 20 and (integrator == "explicit" or min(r[2] for r in steps[1:]) >= 1)
 
 
@@ -329,23 +338,9 @@ def test_lattice_energy_series_continues_across_a_restart(tmp_path):
     series (history.json, sampled every 5 steps, a sample written one step after its time: the
     sample at the restart time t = 1 ms needs the state of the file and comes once) and
     per-step rows as the run without restart, bit for bit."""
-    import json
-    from sphgen import io
     run = ["--tf", "0.002", "--pfreq", "10", "--record-every", "5", "--tol", "1e-12"]
-    lattice(run + ["-d", str(tmp_path / "full")])
-    mid = io.output_files(tmp_path / "full")[1]
-    assert io.step_of(mid) == 10
-    lattice(run + ["-d", str(tmp_path / "part"), "--restart", mid])
-    a = io.load(io.output_files(tmp_path / "full")[-1])["arrays"]["fluid"]
-    b = io.load(io.output_files(tmp_path / "part")[-1])["arrays"]["fluid"]
-    for p in a.data:
-        assert np.array_equal(a.data[p], b.data[p]), p
-    for name in ("history.json", "steps.json"):
-        ra = json.load(open(tmp_path / "full" / name))["rows"]
-        rb = json.load(open(tmp_path / "part" / name))["rows"]
-        assert json.dumps(ra) == json.dumps(rb), name
-    rows = json.load(open(tmp_path / "full" / "history.json"))["rows"]
-    assert [round(r[0], 9) for r in rows] == [0.0, 5e-4, 1e-3, 1.5e-3]
+    _, rows, steps = restart_matches_full_run(lattice, run, tmp_path)
+    assert [round(r[0], 9) for r in rows] == [0.0, 5e-4, 1e-3, 1.5e-3] and len(steps) == 20
     assert abs(rows[-1][3] / rows[0][3] - 1.0) > 0.0
 
 
