@@ -113,7 +113,8 @@ class DamBreak2D(Application):
         group.add_argument("--tol", type=float, default=None,
                            help="--scheme variational: fixed-point tolerance, metres (default 1e-6 dx)")
         group.add_argument("--alpha", type=float, default=None,
-                           help="artificial viscosity (default 0.1 for wcsph and variational (a of eq. 55), 0.05 for ctvf)")
+                           help="artificial viscosity (default 0.1 for wcsph and variational (a of "
+                                "eq. 55), 0.05 for ctvf)")
         group.add_argument("--no-surface-pressure", dest="surface_pressure", action="store_false",
                            help="ctvf: do not hold p = 0 on the free-surface particles")
         group.add_argument("--delta", type=float, default=0.1,
