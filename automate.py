@@ -7,9 +7,9 @@ Simulations go to ``outputs/``, figures to ``manuscript/figures/``.  Finished ca
 from automan.api import Automator
 
 from automation.taylor_green import TaylorGreenEDAC
-from automation.variational import VariationalDamBreak, VariationalEnergy, VariationalOrder
+from automation.variational import VariationalDamBreak, VariationalEjection, VariationalEnergy, VariationalOrder
 
-PROBLEMS = [TaylorGreenEDAC, VariationalDamBreak, VariationalOrder, VariationalEnergy]
+PROBLEMS = [TaylorGreenEDAC, VariationalDamBreak, VariationalOrder, VariationalEnergy, VariationalEjection]
 
 if __name__ == "__main__":
     Automator(simulation_dir="outputs", output_dir="manuscript/figures",

@@ -23,6 +23,13 @@ sections 3.4-3.5, free-slip ghost velocities in the divergence terms, alpha = 0.
 leaves it to the EDAC equation), hydrostatic initial pressure; its energy budget has
 no internal term (EDAC has no equation of state).
 
+``--scheme variational`` runs the time integrators of da Silva & Giraldi (2024) on the same
+geometry (:class:`~schemes.variational.VariationalScheme`): ``--integrator variational``
+(generalised midpoint, ``--midpoint-alpha`` 0.5, fixed-point tolerance ``--tol``, default
+1e-6 dx) or ``explicit`` (leapfrog, eqs. 59-62); K3 Gaussian kernel (lam = 1.3 dx), continuity
+density (eq. 67), AV of eq. 55 with a = ``--alpha`` (0.1) and b = 0, the walls' first layers as
+the repulsive boundary particles of eq. 58 (D = 2 g H, r0 = dx); delta-SPH is not used.
+
 ``post_process`` writes ``results.json``: the toe position Z = x_toe/L against T (largest x
 of the fluid within 2 dx of the floor, ejected particles ignored,
 :func:`sphgen.tools.probes.front_position`), its largest relative deviation from Martin &
@@ -45,6 +52,7 @@ from sphgen.tools.probes import front_position
 from sphgen.tools import reference
 
 from ..schemes.ctvf import CTVFScheme
+from ..schemes.variational import VariationalScheme
 from ..schemes.wcsph import WCSPHScheme
 
 try:
@@ -100,9 +108,17 @@ class DamBreak2D(Application):
         group.add_argument("--kernel", choices=("quintic", "wendland"), default="quintic",
                            help="kernel: quintic spline (support 3h) or Wendland C2 (support 2h; PySPH's "
                                 "dam_break_2d uses it with --hdx 1.3) (default %(default)s)")
-        group.add_argument("--scheme", choices=("wcsph", "ctvf"), default="wcsph", help="scheme (default %(default)s)")
+        group.add_argument("--scheme", choices=("wcsph", "ctvf", "variational"), default="wcsph",
+                           help="scheme (default %(default)s)")
+        group.add_argument("--integrator", choices=("variational", "explicit"), default="variational",
+                           help="--scheme variational: midpoint (eqs. 37, 63-65) or leapfrog (59-62)")
+        group.add_argument("--midpoint-alpha", type=float, default=0.5,
+                           help="--scheme variational: generalised-midpoint alpha (default %(default)s)")
+        group.add_argument("--tol", type=float, default=None,
+                           help="--scheme variational: fixed-point tolerance, metres (default 1e-6 dx)")
         group.add_argument("--alpha", type=float, default=None,
-                           help="artificial viscosity (default 0.1 for wcsph, 0.05 for ctvf)")
+                           help="artificial viscosity (default 0.1 for wcsph and variational (a of "
+                                "eq. 55), 0.05 for ctvf)")
         group.add_argument("--no-surface-pressure", dest="surface_pressure", action="store_false",
                            help="ctvf: do not hold p = 0 on the free-surface particles")
         group.add_argument("--delta", type=float, default=0.1,
@@ -127,6 +143,9 @@ class DamBreak2D(Application):
         if o.scheme == "ctvf" and o.kernel != "quintic":
             raise InputError("--scheme ctvf uses the quintic spline (its near-surface treatment is tied "
                              "to it, Adepu & Ramachandran 2021 sec. 3.5); drop --kernel")
+        if o.scheme == "variational" and o.kernel != "quintic":
+            raise InputError("--scheme variational uses its own kernel (da Silva & Giraldi 2024, eq. 69 "
+                             "variants); drop --kernel")
         if o.alpha is None:
             o.alpha = 0.05 if o.scheme == "ctvf" else 0.1
         if o.scheme == "ctvf":   # no equation of state: no internal energy to sample
@@ -135,9 +154,15 @@ class DamBreak2D(Application):
             v = getattr(o, name)
             if not (np.isfinite(v) and v >= 0):
                 raise InputError(f"--{name} must be a non-negative finite number, got {v}")
+        if not 0.0 <= o.midpoint_alpha <= 1.0:
+            raise InputError(f"--midpoint-alpha must be in [0, 1], got {o.midpoint_alpha}")
+        if o.tol is not None and not (np.isfinite(o.tol) and o.tol > 0):
+            raise InputError(f"--tol must be a positive finite number, got {o.tol}")
         n = max(int(round(L / o.dx)), 4)
         self.dx = L / n
         self.h = o.hdx * self.dx
+        if o.scheme == "variational":   # the Gaussian's neighbour radius sets h (rc = 3h)
+            self.h = VariationalScheme(["fluid"], [], dx=self.dx).h
         self.c0 = o.c0_factor * sqrt(2.0 * G * H)
         self.n_layers = layers_for_support(get_kernel(o.kernel, 2), o.hdx)
         self.history = []
@@ -166,6 +191,11 @@ class DamBreak2D(Application):
             return CTVFScheme(["fluid"], dim=2, rho0=RHO0, c0=self.c0, nu=0.0, h=self.h, dx=self.dx,
                               umax=sqrt(2.0 * G * H), density="continuity", alpha=o.alpha, gy=-G,
                               walls=["wall"], free_surface=True, surface_pressure=o.surface_pressure)
+        if o.scheme == "variational":
+            return VariationalScheme(["fluid"], ["wall"], dim=2, rho0=RHO0, c0=self.c0, gy=-G, kernel="K3",
+                                     dx=self.dx, av_a=o.alpha, av_b=0.0, D=2.0 * G * H, r0=self.dx,
+                                     integrator=o.integrator, alpha=o.midpoint_alpha,
+                                     tol=o.tol if o.tol is not None else 1e-6 * self.dx)
         return WCSPHScheme(["fluid"], ["wall"], dim=2, rho0=RHO0, c0=self.c0, h=self.h, gy=-G,
                            alpha=o.alpha, beta=0.0, delta=o.delta, delta_correction=o.delta_correction,
                            umax=sqrt(2.0 * G * H), wall_alpha=bool(o.wall_alpha), kernel=o.kernel)

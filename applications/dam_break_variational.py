@@ -186,9 +186,7 @@ class DamBreakVariational(Application):
         """Continue the time series exactly: the per-step rows, the last half-step momentum
         (Q is the mean of two), the next sample time and the steps since the last sample."""
         super()._restart(path, data, dt)
-        t = self.solver.t
-        steps = run_folder.earlier_history(path, t, "steps.json")
-        self.steps = [list(r) for r in steps["rows"]] if steps is not None else []
+        self.steps = earlier_steps(path, self.solver.t)
         f = self.scene.by_name["fluid"]
         self._p_prev = np.array([np.sum(f.m * f.u), np.sum(f.m * f.v)])
         if self.history:
@@ -302,6 +300,12 @@ class DamBreakVariational(Application):
         fig.tight_layout()
         fig.savefig(os.path.join(outdir, "iterations.png"), dpi=100)
         plt.close(fig)
+
+
+def earlier_steps(path, t):
+    """The steps.json rows (STEP_COLUMNS) of the run restarted from ``path``, up to time ``t``."""
+    steps = run_folder.earlier_history(path, t, "steps.json")
+    return [list(r) for r in steps["rows"]] if steps is not None else []
 
 
 # ---------------------------------------------------------------- analysis of finished runs

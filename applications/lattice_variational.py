@@ -31,7 +31,7 @@ from sphgen.particles import ParticleArray
 
 from ..equations.variational import kernel_parameters
 from ..schemes.variational import PREDICTORS, VariationalScheme
-from .dam_break_variational import STEP_COLUMNS, iteration_statistics, position_error
+from .dam_break_variational import STEP_COLUMNS, earlier_steps, iteration_statistics, position_error
 
 try:
     from sphgen.errors import InputError
@@ -130,6 +130,18 @@ class LatticeVariational(Application):
         io.write_json(os.path.join(self.outdir, "steps.json"),
                       {"columns": list(STEP_COLUMNS), "rows": self.steps,
                        "evaluations": getattr(self.solver.integrator, "evaluations", None)})
+
+    def _restart(self, path, data, dt):
+        """Continue the energy series exactly: the per-step rows, the state at t_k the next
+        sample needs, and no sample at t_k twice (a sample is written a step after its time)."""
+        super()._restart(path, data, dt)
+        t = self.solver.t
+        self.history = [r for r in self.history if r[0] < t - 0.5 * dt]
+        self.steps = earlier_steps(path, t)
+        f = self.scene.by_name["fluid"]
+        order = np.argsort(f.gid)
+        x, y, u, v, m = (a[order].copy() for a in (f.x, f.y, f.u, f.v, f.m))
+        self._prev = (x, y, u, v, np.array([np.sum(m * u), np.sum(m * v)]))
 
     # ------------------------------------------------------------ diagnostics
     def energy(self, x, y, u, v, m):

@@ -128,6 +128,82 @@ class VariationalDamBreak(SphgenProblem):
         print(json.dumps({k: v for k, v in summary.items() if not k.startswith("results")}, indent=1))
 
 
+EJECTION_VARIANTS = {
+    "closed_box": {},
+    "open_top": dict(open_top=None),
+    "weak_av": dict(av_a=0.1, av_b=0.0),
+    "open_top_weak_av": dict(open_top=None, av_a=0.1, av_b=0.0),
+    "summation_density": dict(density="summation"),
+    "wall_power2": dict(wall_power=2),
+    "K1_as_printed": dict(kernel="K1", tf=0.25),
+    "K2_paper_cutoff": dict(kernel="K2", tf=0.25),
+}
+"""The explicit leapfrog dam break with one unprinted choice changed at a time (the paper's
+"particles go out of the fluid volume", section 6): K1/K2 (651 neighbours) to 0.25 s only."""
+
+
+class VariationalEjection(SphgenProblem):
+    """Free-surface particle ejection (da Silva & Giraldi 2024, section 6, Figs. 2-3) against the
+    choices the paper does not print: lid, AV strength, density, wall-force power, kernel."""
+
+    tf, pfreq = 1.0, 250          # an output every 25 ms (dt = 1e-4 s)
+    times = (0.10, 0.25, 0.50, 0.75, 1.00)
+
+    def get_name(self):
+        return "variational_ejection"
+
+    def setup(self):
+        cmd = self.sphgen("dam_break_variational")
+        self.cases = []
+        for name, kw in EJECTION_VARIANTS.items():
+            kw = dict(dict(tf=self.tf), **kw)
+            self.cases.append(Simulation(self.input_path(name), cmd, job_info=dict(n_core=1, n_thread=1),
+                                         integrator="explicit", pfreq=self.pfreq, threads=1, **kw))
+
+    def run(self):
+        from sphgen.applications.dam_break_variational import DX, ejected, outputs_by_time, positions
+        from sphgen.tools.probes import count_neighbours
+        self.make_output_dir()
+        plt = _plt()
+        out = {"times": list(self.times), "rule_quarter_median": "fewer than 1/4 of the median neighbour "
+               "count within 2.5 dx", "rule_digest": "at most 2 other fluid particles within 2 dx"}
+        f, axes = plt.subplots(len(self.cases), 2, figsize=(9, 2.3 * len(self.cases)), sharex=True, sharey=True)
+        for row, case in zip(axes, self.cases):
+            name = os.path.basename(case.input_path())
+            if not os.path.exists(case.input_path("results.json")):
+                print(f"{name:18s} not run")
+                continue
+            files = outputs_by_time(case.input_path())
+            rec = {"quarter_median": [], "digest": [], "y_max": [], "rho_max": None}
+            for t in self.times:
+                path = files.get(round(t, 9))
+                if path is None:
+                    for k in ("quarter_median", "digest", "y_max"):
+                        rec[k].append(None)
+                    continue
+                _, x, y = positions(path)
+                rec["quarter_median"].append(int(ejected(x, y).sum()))
+                rec["digest"].append(int((count_neighbours((x, y), 2.0 * DX) < 4).sum()))
+                rec["y_max"].append(float(y.max()))
+            r = self.results(case)
+            rec.update({k: r.get(k) for k in ("rho_min", "rho_max", "Q_max", "t")})
+            out[name] = rec
+            shown = [t for t in (0.25, 0.50) if files.get(round(t, 9))]
+            for ax, t in zip(row, shown):
+                _, x, y = positions(files[round(t, 9)])
+                e = ejected(x, y)
+                ax.plot(x[~e], y[~e], ".", ms=1, color="tab:blue")
+                ax.plot(x[e], y[e], ".", ms=3, color="tab:red")
+                ax.set_title(f"{name}, t = {t:.2f} s ({int(e.sum())} ejected)", fontsize=8)
+                ax.set_aspect("equal")
+            print(f"{name:18s} ejected (1/4 median) {rec['quarter_median']}  (<=2 nbrs in 2dx) {rec['digest']}")
+        f.tight_layout()
+        f.savefig(self.output_path("variational_ejection.png"), dpi=110)
+        plt.close(f)
+        with open(self.output_path("variational_ejection.json"), "w") as fh:
+            json.dump(out, fh, indent=1)
+
+
 def _local_maxima(t, q, smooth=5):
     """(t, Q) of the local maxima of Q smoothed over ``smooth`` samples (its oscillation)."""
     if q.size < 3 * smooth:
@@ -244,7 +320,8 @@ class VariationalEnergy(SphgenProblem):
         print(json.dumps(out, indent=1))
 
 
-PROBLEMS = {p.__name__: p for p in (VariationalDamBreak, VariationalOrder, VariationalEnergy)}
+PROBLEMS = {p.__name__: p for p in (VariationalDamBreak, VariationalOrder, VariationalEnergy,
+                                     VariationalEjection)}
 
 
 def run_serially(name, sim_dir="outputs", out_dir="manuscript/figures"):
