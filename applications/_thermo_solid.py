@@ -77,7 +77,8 @@ class ThermoSolid(Application):
                                   jumps=o.jumps, projection=o.projection, cfl=o.cfl, **VARIANTS[o.variant])
 
     def set_probe(self, X):
-        """The particle nearest to ``probe_point`` among the (unperturbed) lattice points X (n, 3)."""
+        """The particle (its gid: the creation index; sorting moves particles in memory) nearest
+        to ``probe_point`` among the (unperturbed) lattice points X (n, 3)."""
         self.probe = int(np.argmin(np.linalg.norm(X - np.asarray(self.probe_point), axis=1)))
         return self.probe
 
@@ -94,7 +95,7 @@ class ThermoSolid(Application):
         L = (pa.V[:, None] * p).sum(0)
         A = (pa.V[:, None] * np.cross(x, p)).sum(0)
         e = self.scheme.energies([pa])
-        i = self.probe
+        i = int(np.flatnonzero(pa.gid == self.probe)[0])
         u = [pa.x[i] - pa.x0[i], pa.y[i] - pa.y0[i], pa.z[i] - pa.z0[i]]
         self.history.append([solver.t, *L, *A, float(np.sum(pa.V * np.linalg.norm(p, axis=1))),
                              e["kinetic"], e["internal"], e["total"], e["ballistic"], e["entropy"],
