@@ -87,12 +87,14 @@ class ThermoPunch(ThermoSolid):
                                                               self.options.kernel)}
 
     def case_meta(self):
-        return {"r_out": self.options.r_out, "r_in": self.options.r_in}
+        """(with the snapshots' R[p], so that a run that stops early keeps them in history.json)"""
+        return {"r_out": self.options.r_out, "r_in": self.options.r_in,
+                "snapshots": {f"{ts:g}": v for ts, v in sorted(self.snapshots.items())}}
 
     def post_process(self, outdir):
         """Insulated and the roller does no work: E_tot constant and S never falls, from t = 0."""
-        snaps = {f"{ts:g}": v for ts, v in sorted(self.snapshots.items())}
-        r = self.write_results(outdir, checks(self.history_columns, self.history, 0.0, 0.0), {"snapshots": snaps})
+        r = self.write_results(outdir, checks(self.history_columns, self.history, 0.0, 0.0))
+        snaps = r["snapshots"]
         R = ", ".join(f"{k} s: {v['R_p']:.3g}" for k, v in snaps.items())
         print(f"thermo_punch: N={r['n_particles']} t={self.solver.t:.4g} ({self.options.variant}, "
               f"{self.options.form}-form): energy residual {r['energy_residual']:.2e}, S fall {r['entropy_fall']}, "
