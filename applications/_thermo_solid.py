@@ -7,6 +7,7 @@ Variants (``--variant``): ``full`` is the paper's {p, F, H, J, E} scheme with D_
 54d, 66, 73), ``reduced`` the {p, F, H, E} scheme of its Fig. 16 (J = det F, no D_J),
 ``full-no-DJ`` the full scheme without D_J (an ablation; docs/thermo.md).
 """
+import json
 import os
 
 import numpy as np
@@ -147,6 +148,17 @@ def cylinder_lattice(dx, r_out, z0, z1, r_in=0.0):
 def columns_of(columns, rows):
     h = np.array(rows, dtype=float)
     return {k: h[:, i] for i, k in enumerate(columns)}
+
+
+def run_quietly(app, outdir, *args):
+    """Run the application class ``app`` into ``outdir`` (one thread, no particle files) and
+    read back (results.json, {column: array} of history.json) — for tests and scripts."""
+    app().run(["-d", str(outdir), "--no-progress", "--disable-output", "--threads", "1", *args])
+    with open(os.path.join(outdir, "results.json")) as f:
+        r = json.load(f)
+    with open(os.path.join(outdir, "history.json")) as f:
+        h = json.load(f)
+    return r, columns_of(h["columns"], h["rows"])
 
 
 def checks(columns, rows, free_from, law_from=0.0):

@@ -7,21 +7,15 @@ max_t(K + |W_ext| + |Q_in| + |E_Dir|); second law: the body is insulated, so S n
 falls (tolerance 1e-3 of its rise).  The fast test squeezes the load into 0.2 s on a
 coarse lattice; the slow one runs the paper's load history on the 1323-particle lattice.
 """
-import json
-
 import numpy as np
 import pytest
 
+from sphgen.applications._thermo_solid import run_quietly
 from sphgen.applications.l_block import LBlock, load_history
 
 
 def run(out, *args):
-    LBlock().run(["-d", str(out), "--no-progress", "--disable-output", "--threads", "1", *args])
-    with open(out / "results.json") as f:
-        r = json.load(f)
-    with open(out / "history.json") as f:
-        h = json.load(f)
-    return r, {k: np.array([row[i] for row in h["rows"]]) for i, k in enumerate(h["columns"])}
+    return run_quietly(LBlock, out, *args)
 
 
 def check(r, h, load_time):

@@ -6,22 +6,15 @@ heat flux, E_tot flat, S never falls and B never rises (1e-3 of their change); t
 and eta-form probe v_Z within 5 % (relative L2 in time).  The fast tests squeeze the heat
 flux into 0.2 s on the coarsest lattice; the slow one runs the paper's 10 s at dx = 0.5.
 """
-import json
-
 import numpy as np
 import pytest
 
-from sphgen.applications._thermo_solid import relative_l2_in_time
+from sphgen.applications._thermo_solid import relative_l2_in_time, run_quietly
 from sphgen.applications.thermo_disk import ThermoDisk, heat_flux
 
 
 def run(out, *args):
-    ThermoDisk().run(["-d", str(out), "--no-progress", "--disable-output", "--threads", "1", *args])
-    with open(out / "results.json") as f:
-        r = json.load(f)
-    with open(out / "history.json") as f:
-        h = json.load(f)
-    return r, {k: np.array([row[i] for row in h["rows"]]) for i, k in enumerate(h["columns"])}
+    return run_quietly(ThermoDisk, out, *args)
 
 
 def check(r, h, form):

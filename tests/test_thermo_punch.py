@@ -7,19 +7,15 @@ runs the coarsest lattice to 0.22 s; the slow ones the paper's 0.4 s at dx = 1/6
 paper's raw jumps, where the full scheme's R[p] must be at most half the reduced one's at
 0.21 and 0.35 s, and the full scheme at dx = 0.1 (2728 particles), which stops early (xfail).
 """
-import json
-
 import numpy as np
 import pytest
 
-from sphgen.applications._thermo_solid import checkerboard
+from sphgen.applications._thermo_solid import checkerboard, run_quietly
 from sphgen.applications.thermo_punch import ThermoPunch
 
 
 def run(out, *args):
-    ThermoPunch().run(["-d", str(out), "--no-progress", "--disable-output", "--threads", "1", *args])
-    with open(out / "results.json") as f:
-        return json.load(f)
+    return run_quietly(ThermoPunch, out, *args)[0]
 
 
 def test_checkerboard_indicator_sees_a_checkerboard_not_a_linear_field():
