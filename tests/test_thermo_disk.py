@@ -9,7 +9,7 @@ flux into 0.2 s on the coarsest lattice; the slow one runs the paper's 10 s at d
 import numpy as np
 import pytest
 
-from sphgen.applications._thermo_solid import relative_l2_in_time, run_quietly
+from sphgen.applications._thermo_solid import cylinder_lattice, relative_l2_in_time, run_quietly
 from sphgen.applications.thermo_disk import ThermoDisk, heat_flux
 
 
@@ -33,6 +33,17 @@ def check(r, h, form):
 
 def test_heat_flux_is_the_papers():
     assert [heat_flux(t) for t in (0.0, 1.0, 2.0, 3.0, 4.5)] == pytest.approx([0.0, 1.0, 0.0, -1.0, 0.0], abs=1e-15)
+
+
+def test_cylinder_lattice_is_symmetric_with_cell_fraction_volumes():
+    x, y, z, V, f = cylinder_lattice(0.5, 5.0, -0.5, 0.5)
+    assert x.size == 948 and np.all((V > 0) & (V <= 0.125 + 1e-15)) and np.all((f > 0) & (f <= 1))
+    assert abs(np.sum(V * x)) < 1e-12 and abs(np.sum(V * y)) < 1e-12 and abs(np.sum(V * z)) < 1e-12
+    assert abs(V.sum() / (np.pi * 25.0) - 1) < 0.03
+    assert np.all(np.hypot(x, y)[f < 1] > 4.5)       # the cut cells are on the rim
+    x, y, z, V, f = cylinder_lattice(0.25, 1.0, 0.0, 1.0, 0.5)     # the punch's hollow cylinder
+    r = np.hypot(x, y)
+    assert x.size == 200 and r.min() >= 0.5 - 1e-12 and r.max() <= 1.0 + 1e-12
 
 
 @pytest.fixture(scope="module")
