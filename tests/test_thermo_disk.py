@@ -68,7 +68,7 @@ def test_energy_and_entropy_forms_agree_at_the_probe(short_runs):
 
 
 @pytest.mark.slow
-def test_paper_run_on_the_951_particle_lattice(tmp_path):
+def test_paper_run_on_the_948_particle_lattice(tmp_path):
     """dx = 0.5, the paper's heat flux to 4 s, to 10 s, E- and eta-form."""
     r, h = run(tmp_path / "E", "--dx", "0.5")
     check(r, h, "E")
