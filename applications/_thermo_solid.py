@@ -26,10 +26,12 @@ VARIANTS = {"full": dict(reduced=False, dissipation=True), "reduced": dict(reduc
 
 class ThermoSolid(Application):
     """Base of the sec. 7 applications of Ghavamian et al. (2021): subclasses set
-    ``default_variant``, ``default_projection``, ``probe_point`` and build particles and loads."""
+    ``default_variant``, ``default_jumps``, ``default_projection``, ``probe_point`` and build
+    particles and loads."""
 
     dim = 3
     default_variant = "full"
+    default_jumps = "limited"
     default_projection = True
     probe_point = (0.0, 0.0, 0.0)
     history_columns = ("t", "L_x", "L_y", "L_z", "A_x", "A_y", "A_z", "sum_V_abs_p", "kinetic", "internal",
@@ -45,8 +47,9 @@ class ThermoSolid(Application):
         group.add_argument("--hdx", type=float, default=1.2, help="h / dx (default %(default)s)")
         group.add_argument("--kernel", choices=("wendland", "quintic"), default="wendland",
                            help="smoothing kernel (default %(default)s)")
-        group.add_argument("--jumps", choices=("limited", "raw"), default="limited",
-                           help="dissipation on limited reconstructed jumps or the paper's raw jumps")
+        group.add_argument("--jumps", choices=("limited", "raw"), default=self.default_jumps,
+                           help="dissipation on limited reconstructed jumps or the paper's raw jumps "
+                                "(default %(default)s)")
         group.add_argument("--form", choices=("E", "eta"), default="E", help="total energy or entropy")
         if self.default_projection:
             group.add_argument("--no-projection", dest="projection", action="store_false",

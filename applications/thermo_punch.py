@@ -8,7 +8,8 @@ roller on the base Z = 0 (v_Z = 0), every other face traction-free; insulated.
 Mie-Gruneisen, E = 50.05 kPa, nu = 0.499, rho_R = 1000, k = 10, C_v = 1, alpha = 2.223e-4,
 theta_R = 293.15 K; E-form, alpha_CFL = 0.3 (with the adiabatic c_p, 132 m/s), no
 angular-momentum projection; to 0.4 s.  Default scheme: the paper's full {p, F, H, J, E}
-(``--variant reduced`` is the {p, F, H, E} scheme of its Fig. 16).
+with the paper's raw jumps (``--variant reduced`` is the {p, F, H, E} scheme of its Fig.
+16; with ``--jumps limited`` the full scheme stops near 0.27 s at dx = 0.1, docs/thermo.md).
 
 Probe X = [0, 1, 1] (on the outer top edge).  The checkerboard indicator R[p]
 (``_thermo_solid.checkerboard``) is taken at the first step at or after 0.07 k s, k = 1..5
@@ -36,6 +37,7 @@ class ThermoPunch(ThermoSolid):
     tf = 0.4
     pfreq = 500
     default_variant = "full"
+    default_jumps = "raw"
     default_projection = False
     probe_point = (0.0, 1.0, 1.0)
 
