@@ -80,11 +80,15 @@ class ThermoRK2Step(IntegratorStep):
 
     def stage2(self, d_idx, d_x, d_y, d_z, d_u, d_v, d_w, d_F, d_H, d_J, d_E, d_eta, d_xn, d_yn,
                d_zn, d_un, d_vn, d_wn, d_Fn, d_Hn, d_Jn, d_En, d_etan, d_rho, d_tint, d_fb, d_aF,
-               d_aH, d_aJ, d_aE, d_aeta, dt):
-        """U* = U^n + dt dU/dt(U^n), x* = x^n + dt v^n (eq. 77, first stage)."""
-        d_x[d_idx] = d_xn[d_idx] + dt * d_un[d_idx]
-        d_y[d_idx] = d_yn[d_idx] + dt * d_vn[d_idx]
-        d_z[d_idx] = d_zn[d_idx] + dt * d_wn[d_idx]
+               d_aH, d_aJ, d_aE, d_aeta, d_rk, dt):
+        """A stage of eq. 77: U <- c U^n + (1 - c)(U + dt dU/dt(U)), x <- c x^n + (1 - c)(x + dt v)
+        with c = rk[0]: 0 in the first stage (where U = U^n: U* = U^n + dt dU/dt(U^n)), 1/2 in
+        the second (U^{n+1} = (U^n + U* + dt dU/dt(U*)) / 2)."""
+        c = d_rk[0]
+        b = 1.0 - c
+        d_x[d_idx] = c * d_xn[d_idx] + b * (d_x[d_idx] + dt * d_u[d_idx])
+        d_y[d_idx] = c * d_yn[d_idx] + b * (d_y[d_idx] + dt * d_v[d_idx])
+        d_z[d_idx] = c * d_zn[d_idx] + b * (d_z[d_idx] + dt * d_w[d_idx])
         ri = dt / d_rho[d_idx]
         fx = d_tint[3 * d_idx]
         fy = d_tint[3 * d_idx + 1]
@@ -93,18 +97,18 @@ class ThermoRK2Step(IntegratorStep):
             fx += d_fb[3 * d_idx]
             fy += d_fb[3 * d_idx + 1]
             fz += d_fb[3 * d_idx + 2]
-        d_u[d_idx] = d_un[d_idx] + ri * fx
-        d_v[d_idx] = d_vn[d_idx] + ri * fy
-        d_w[d_idx] = d_wn[d_idx] + ri * fz
+        d_u[d_idx] = c * d_un[d_idx] + b * (d_u[d_idx] + ri * fx)
+        d_v[d_idx] = c * d_vn[d_idx] + b * (d_v[d_idx] + ri * fy)
+        d_w[d_idx] = c * d_wn[d_idx] + b * (d_w[d_idx] + ri * fz)
         for k in range(9):
-            d_F[9 * d_idx + k] = d_Fn[9 * d_idx + k] + dt * d_aF[9 * d_idx + k]
-            d_H[9 * d_idx + k] = d_Hn[9 * d_idx + k] + dt * d_aH[9 * d_idx + k]
+            d_F[9 * d_idx + k] = c * d_Fn[9 * d_idx + k] + b * (d_F[9 * d_idx + k] + dt * d_aF[9 * d_idx + k])
+            d_H[9 * d_idx + k] = c * d_Hn[9 * d_idx + k] + b * (d_H[9 * d_idx + k] + dt * d_aH[9 * d_idx + k])
         if not self.reduced:
-            d_J[d_idx] = d_Jn[d_idx] + dt * d_aJ[d_idx]
+            d_J[d_idx] = c * d_Jn[d_idx] + b * (d_J[d_idx] + dt * d_aJ[d_idx])
         if self.form == 0:
-            d_E[d_idx] = d_En[d_idx] + dt * d_aE[d_idx]
+            d_E[d_idx] = c * d_En[d_idx] + b * (d_E[d_idx] + dt * d_aE[d_idx])
         else:
-            d_eta[d_idx] = d_etan[d_idx] + dt * d_aeta[d_idx]
+            d_eta[d_idx] = c * d_etan[d_idx] + b * (d_eta[d_idx] + dt * d_aeta[d_idx])
 
     def stage3(self, d_idx, d_u, d_v, d_w, d_vfix, d_vB, d_tfix, d_thB, d_F, d_H, d_J, d_E, d_eta,
                d_dEbc, d_rho, d_mat):
@@ -145,35 +149,7 @@ class ThermoRK2Step(IntegratorStep):
             d_xc[3 * d_idx + 1] = d_yn[d_idx] + 0.5 * dt * (d_vn[d_idx] + d_v[d_idx])
             d_xc[3 * d_idx + 2] = d_zn[d_idx] + 0.5 * dt * (d_wn[d_idx] + d_w[d_idx])
 
-    def stage5(self, d_idx, d_x, d_y, d_z, d_u, d_v, d_w, d_F, d_H, d_J, d_E, d_eta, d_xn, d_yn,
-               d_zn, d_un, d_vn, d_wn, d_Fn, d_Hn, d_Jn, d_En, d_etan, d_rho, d_tint, d_fb, d_aF,
-               d_aH, d_aJ, d_aE, d_aeta, dt):
-        """U^{n+1} = (U^n + U* + dt dU/dt(U*)) / 2 and x^{n+1} = (x^n + x* + dt v*) / 2 (eq. 77)."""
-        d_x[d_idx] = 0.5 * (d_xn[d_idx] + d_x[d_idx] + dt * d_u[d_idx])
-        d_y[d_idx] = 0.5 * (d_yn[d_idx] + d_y[d_idx] + dt * d_v[d_idx])
-        d_z[d_idx] = 0.5 * (d_zn[d_idx] + d_z[d_idx] + dt * d_w[d_idx])
-        ri = dt / d_rho[d_idx]
-        fx = d_tint[3 * d_idx]
-        fy = d_tint[3 * d_idx + 1]
-        fz = d_tint[3 * d_idx + 2]
-        if self.external:
-            fx += d_fb[3 * d_idx]
-            fy += d_fb[3 * d_idx + 1]
-            fz += d_fb[3 * d_idx + 2]
-        d_u[d_idx] = 0.5 * (d_un[d_idx] + d_u[d_idx] + ri * fx)
-        d_v[d_idx] = 0.5 * (d_vn[d_idx] + d_v[d_idx] + ri * fy)
-        d_w[d_idx] = 0.5 * (d_wn[d_idx] + d_w[d_idx] + ri * fz)
-        for k in range(9):
-            d_F[9 * d_idx + k] = 0.5 * (d_Fn[9 * d_idx + k] + d_F[9 * d_idx + k] + dt * d_aF[9 * d_idx + k])
-            d_H[9 * d_idx + k] = 0.5 * (d_Hn[9 * d_idx + k] + d_H[9 * d_idx + k] + dt * d_aH[9 * d_idx + k])
-        if not self.reduced:
-            d_J[d_idx] = 0.5 * (d_Jn[d_idx] + d_J[d_idx] + dt * d_aJ[d_idx])
-        if self.form == 0:
-            d_E[d_idx] = 0.5 * (d_En[d_idx] + d_E[d_idx] + dt * d_aE[d_idx])
-        else:
-            d_eta[d_idx] = 0.5 * (d_etan[d_idx] + d_eta[d_idx] + dt * d_aeta[d_idx])
-
-    def stage6(self, d_idx, d_u, d_v, d_w, d_F, d_H, d_J, d_E, d_eta, d_theta, d_rho, d_mat):
+    def stage5(self, d_idx, d_u, d_v, d_w, d_F, d_H, d_J, d_E, d_eta, d_theta, d_rho, d_mat):
         """Initial state: E (eq. 23 inverted) or eta (eq. 19) from the given temperature."""
         F = declare("matrix(9)")
         H = declare("matrix(9)")
@@ -267,7 +243,7 @@ class ThermoRK2(Integrator):
         then overwrites it with the file's state."""
         super().attach(scene)
         self.compute_accelerations(3, 0.0, 0.0)
-        self.scene.stage("stage6", 0.0, 0.0)
+        self.scene.stage("stage5", 0.0, 0.0)
         self.impose(0.0)
         self.state(2, 0.0, 0.0, "in the initial state")
 
@@ -280,17 +256,23 @@ class ThermoRK2(Integrator):
         b[1] += dq
         b[2] += de
 
+    def _rk(self, c):
+        for pa in self._arrays():
+            pa.rk[0] = c
+
     def one_timestep(self, t, dt):
         self.scene.stage("stage1", t, dt)
         p1 = self.apply_loads(t)
         self.compute_accelerations(0, t, dt)
+        self._rk(0.0)
         self.scene.stage("stage2", t, dt)
         r1 = self.impose(t + dt)
         self.scene.stage("stage4", t, dt)
         self.state(1, t + dt, dt, f"after the first stage of step {self.step_count + 1}")
         p2 = self.apply_loads(t + dt)
         self.compute_accelerations(0, t + dt, dt)
-        self.scene.stage("stage5", t, dt)
+        self._rk(0.5)
+        self.scene.stage("stage2", t, dt)
         r3 = self.impose(t + dt)
         self.state(2, t + dt, dt, f"at the end of step {self.step_count + 1}")
         for name in self.bodies:
@@ -409,6 +391,8 @@ class ThermoUpwindScheme(Scheme):
             pa.add_constant("mat", mat.constants())
             if "budget" not in pa.constants:
                 pa.add_constant("budget", np.zeros(3))
+            if "rk" not in pa.constants:
+                pa.add_constant("rk", np.zeros(1))       # the weight of U^n in a stage of eq. 77
         missing = [b for b in self.bodies if b not in self.arrays]
         if missing:
             raise InputError(f"ThermoUpwindScheme: no particle array named {missing[0]!r}")
@@ -419,20 +403,18 @@ class ThermoUpwindScheme(Scheme):
 
     # ------------------------------------------------------------------ pieces
     def get_equations(self):
-        form, rec = FORMS[self.form], int(self.jumps != "raw")
+        form, rec, red = FORMS[self.form], int(self.jumps != "raw"), int(self.reduced)
         model = self.material.model
         rates, state, state_speeds, once = [], [], [], []
         for b in self.bodies:
             ext = int(any(name == b for name, _ in self.loads))
             rates += [Group([EntropyVariableGradients(b, [b], form=form, reconstruct=rec)], reference=True),
-                      Group([UpwindFluxes(b, [b], form=form, reconstruct=rec, reduced=int(self.reduced),
-                                          dissipation=self.dissipation, external=ext)],
-                            reference=True)]
+                      Group([UpwindFluxes(b, [b], form=form, reconstruct=rec, reduced=red,
+                                          dissipation=self.dissipation, external=ext)], reference=True)]
             if self.projection:
                 rates.append(Group([AngularMomentumProjection(b)]))
-            st = ThermoState(b, model=model, form=form, reduced=int(self.reduced))
-            state.append(Group([st]))
-            state_speeds.append(Group([ThermoState(b, model=model, form=form, reduced=int(self.reduced)),
+            state.append(Group([ThermoState(b, model=model, form=form, reduced=red)]))
+            state_speeds.append(Group([ThermoState(b, model=model, form=form, reduced=red),
                                        WaveSpeeds(b, model=model, hmin=self.dx)]))
             once.append(Group([CorrectionMatrix(b, [b])], reference=True))
         return [rates, state, state_speeds, once]
