@@ -71,3 +71,16 @@ class Heater(Equation):
             q = ramp * self.power * source_kernel(sqrt(dx * dx + dy * dy), self.H) / d_rho[d_idx]
             d_sdot[d_idx] += q / d_T[d_idx]
         d_qheat[d_idx] = q
+
+
+class WallPressureFloor(Equation):
+    """p_a = max(p_a, 0) on solid (ADIABATIC, COOLER) particles: a dry wall, below its calibrated
+    density, does not pull the fluid (docs/superfluid.md, the fountain, decision 3; not in Kincl 2023)."""
+
+    def __init__(self, dest, sources=None):
+        super().__init__(dest, None)
+
+    def post_loop(self, d_idx, d_ptype, d_p):
+        if d_ptype[d_idx] != 0:
+            if d_p[d_idx] < 0.0:
+                d_p[d_idx] = 0.0

@@ -11,9 +11,14 @@
 
 Gravity acts on v and v_s (the base scheme's ``gravity``).
 """
-from sphgen.errors import InputError
+import numpy as np
 
-from ..equations.superfluid_fountain import Heater, superleak_factor, superleak_rate
+from sphgen.equation import Group
+from sphgen.errors import InputError
+from sphgen.tools.probes import kernel_values, pairs_within
+
+from ..equations.superfluid_fountain import Heater, WallPressureFloor, superleak_factor, superleak_rate
+from ..equations.superfluid import FLUID
 from ..equations.superfluid_energy import HELIUM_1_65K, linear_temperature, normal_fraction
 from .superfluid import SuperfluidScheme, SuperfluidStep, SuperfluidVerlet
 
@@ -48,9 +53,29 @@ class FountainStep(SuperfluidStep):
 
 
 class FountainVerlet(SuperfluidVerlet):
-    """:class:`~sphgen.schemes.superfluid.SuperfluidVerlet` with the superleak (stage 8) after the first drift."""
+    """:class:`~sphgen.schemes.superfluid.SuperfluidVerlet` with the superleak (stage 8) after the first drift.
+
+    ``wet``: {array: (x, y, m)} of the fluid the walls will meet (the empty space above the
+    level): the density constants of the array's wall particles are calibrated as if that
+    fluid were there, so a wall reaches its calibrated density (and pressure) when wetted,
+    not when dry (docs/superfluid.md, the fountain, decision 3).
+    """
 
     position_time = dict(SuperfluidVerlet.position_time, stage8=0.5)
+
+    def __init__(self, wet=None, kernel=None, **kw):
+        super().__init__(**kw)
+        self.wet, self.kernel = dict(wet or {}), kernel
+
+    def calibrate_density(self, t, dt):
+        super().calibrate_density(t, dt)
+        for name, (gx, gy, gm) in self.wet.items():
+            pa = self.scene.by_name[name]
+            walls = np.flatnonzero(np.asarray(pa.ptype) != FLUID)
+            h = pa.h[walls]
+            i, j, r = pairs_within((pa.x[walls], pa.y[walls]), (gx, gy), self.kernel.radius_scale * h.max())
+            w = kernel_values(self.kernel, r, h[i]) * np.broadcast_to(np.asarray(gm, dtype=float), np.shape(gx))[j]
+            pa.crho[walls] -= np.bincount(i, w, minlength=walls.size)
 
     def one_timestep(self, t, dt):
         self.stage("stage1", t, dt)
@@ -69,18 +94,19 @@ class FountainScheme(SuperfluidScheme):
     """Two-fluid helium-4 with gravity, heater and superleak (Kincl 2023, eqs. 3.52, 3.58-3.59).
 
     ``heater``: dict(x_heat, y_heat, H, power [W/m], t_ramp); ``superleak``: dict(k0 [1/s],
-    y_sl, d_sl, r_sl) (lengths in m).  The rest as :class:`SuperfluidScheme`; 2D only
+    y_sl, d_sl, r_sl) (lengths in m); ``wet``: see :class:`FountainVerlet`.  The rest as :class:`SuperfluidScheme`; 2D only
     (the thesis' fountain has translational symmetry); not the reversible variant
     (the sources are not reversible).
     """
 
-    def __init__(self, arrays=("helium",), model=HELIUM_1_65K, heater=None, superleak=None, **kw):
+    def __init__(self, arrays=("helium",), model=HELIUM_1_65K, heater=None, superleak=None, wet=None, **kw):
         if kw.get("dim", 2) != 2:
             raise InputError("FountainScheme: the fountain is 2D (dim=2)")
         if kw.get("reversible"):
             raise InputError("FountainScheme: the heater and superleak are not reversible")
         super().__init__(arrays=arrays, dim=2, model=model, **kw)
         self.output_props = self.output_props + ("qheat",)
+        self.wet = wet
         self.heater = {**dict(x_heat=0.0, y_heat=0.0, H=1.0, power=0.0, t_ramp=0.0), **(heater or {})}
         self.superleak = {**dict(k0=0.0, y_sl=0.0, d_sl=1.0, r_sl=0.0), **(superleak or {})}
 
@@ -96,13 +122,22 @@ class FountainScheme(SuperfluidScheme):
             if pa.name in self.arrays and not pa.has("qheat"):
                 pa.add_property("qheat")
 
+    def _density_state(self):
+        groups = super()._density_state()
+        last = groups[-1]
+        return groups[:-1] + [Group(last.equations + [WallPressureFloor(d) for d in self.arrays])]
+
+    def density_bounds(self):
+        """(0.05, 2) rho0: dry walls sit far below rho0 (they are calibrated wet)."""
+        return {a: (0.05 * self.model.rho0, 2.0 * self.model.rho0) for a in self.arrays}
+
     def _entropy_rate(self):
         return super()._entropy_rate() + [Heater(d, **self.heater) for d in self.arrays]
 
     def get_integrator(self):
         m = self.model
         step = FountainStep(2, T0=m.T0, s0=m.s0, rhon0=m.rhon0, cv=m.cv, gamma=m.gamma, **self.superleak)
-        return FountainVerlet(calibrate=self.arrays if self.calibrate else (),
+        return FountainVerlet(calibrate=self.arrays if self.calibrate else (), wet=self.wet, kernel=self.kernel,
                               **{name: step for name in self.arrays})
 
     def heater_power(self, arrays):
