@@ -269,7 +269,9 @@ def plot(outdir, hist, res):
     c = {k: rows[:, i] for i, k in enumerate(hist["columns"])}
     fs = np.array(res["flux_series"])
     fig, (a, b, d) = plt.subplots(1, 3, figsize=(14, 4))
-    a.plot(fs[:, 0], fs[:, 1], "b-", lw=0.8, label="flux counter")
+    a.plot(fs[:, 0], fs[:, 1], "b-", lw=0.5, alpha=0.5, label="flux counter")
+    k = min(10, len(fs))
+    a.plot(fs[:, 0], np.convolve(fs[:, 1], np.ones(k) / k, "same"), "b-", lw=1.5, label=f"moving mean of {k}")
     a.axhline(res["flux_theory"], color="k", ls="--", label="eq. 3.56")
     a.set_xlabel("t [s]")
     a.set_ylabel("Q [kg/(m s)]")

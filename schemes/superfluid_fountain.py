@@ -77,17 +77,9 @@ class FountainVerlet(SuperfluidVerlet):
             w = kernel_values(self.kernel, r, h[i]) * np.broadcast_to(np.asarray(gm, dtype=float), np.shape(gx))[j]
             pa.crho[walls] -= np.bincount(i, w, minlength=walls.size)
 
-    def one_timestep(self, t, dt):
-        self.stage("stage1", t, dt)
-        self.stage("stage2", t, dt)
+    def sources(self, t, dt):
+        """The superleak, between steps 2 and 3 of sec. 3.4."""
         self.stage("stage8", t, dt)
-        self.update_nnps()
-        self.compute_accelerations(0, t + 0.5 * dt, dt)
-        self.stage("stage3", t, dt)
-        self.stage("stage2", t, dt)
-        self.update_nnps()
-        self.compute_accelerations(1, t + dt, dt)
-        self.stage("stage1", t + dt, dt)
 
 
 class FountainScheme(SuperfluidScheme):

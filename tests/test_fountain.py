@@ -117,8 +117,9 @@ def run(out, *extra):
 @pytest.fixture(scope="module")
 def short(tmp_path_factory):
     """The quick preset, 60 W/m, 60 steps, a history row every 10 steps."""
+    dt = 0.4 * 1.4 * R_CAP / MODEL.c1            # the quick preset: dr = r_cap, h = 1.4 dr
     return run(tmp_path_factory.mktemp("fountain") / "short", "--power", "60", "--max-steps", "60",
-               "--tf", str(200 * 10 * 5.425e-6 * 0.4 * 1.4 / 0.4 / 1.4))
+               "--tf", str(200 * 10 * dt))
 
 
 def test_quick_preset_few_steps(short):
@@ -145,9 +146,26 @@ def test_quick_preset_few_steps(short):
 
 
 @pytest.mark.slow
-def test_quick_preset_flux_against_eq_3_56(tmp_path):
-    """Quick preset at 80 W/m to t = 0.15 s (minutes on one core): report Q against eq. 3.56."""
+def test_quick_preset_jet(tmp_path):
+    """Quick preset at 80 W/m to t = 0.12 s (minutes on one core): the jet leaves the capillary,
+    the cell is a few mK above T0, mass is conserved (the flux against eq. 3.56 is reported in
+    docs/superfluid.md; the 5 % check is the paper preset's, below)."""
     app, res, hist = run(tmp_path / "quick80", "--power", "80")
-    assert res["t"] == pytest.approx(0.15, rel=1e-9)
-    assert res["flux"] > 0
-    assert abs(res["flux_error"]) < 0.25, res     # the coarse preset; see docs/superfluid.md
+    assert res["t"] == pytest.approx(0.12, rel=1e-9)
+    assert res["flux"] > 0 and res["jet_height"] > 0
+    assert 0.0 < res["dT_cell"] < 0.02
+    assert res["mass_drift"] == 0.0
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("power", [60.0, 80.0])
+def test_paper_preset_flux_within_5_percent_of_eq_3_56(tmp_path, power):
+    """Issue 13: the paper preset (143 000 particles, 221 000 steps: days on one core), mean flux
+    over the last 0.1 s within 5 % of eq. 3.56 with the measured s_cell, T_cell."""
+    app = load_application("fountain")()
+    out = tmp_path / f"paper{power:g}"
+    app.run(["--preset", "paper", "--power", str(power), "-d", str(out), "--disable-output",
+             "--no-progress"])
+    with open(out / "results.json") as f:
+        res = json.load(f)
+    assert abs(res["flux_error"]) < 0.05, res
