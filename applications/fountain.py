@@ -7,14 +7,14 @@ capillary.  2D (translational symmetry), gravity on v and v_s, COOLER walls (T =
 the cryostat.  The thesis' Fig. 3.4 is an image without numbers: the apparatus below is the
 authors' code's (lengths in mm; docs/superfluid.md, "The fountain"):
 
-* two solids, mirror images about x = 0 (:func:`inside_solid`): the cell wall
-  r_cap + 9.9 .. r_cap + 17.1 wide... (the profile of the authors' code), leaving the cell
-  |x| < 7.975, 0 < y < 16.7, and the capillary |x| < r_cap = 0.775 from the cell roof to its
-  exit at y = 33.7;
+* two solids, mirror images about x = 0 (:func:`inside_profile`, the profile of the
+  authors' code), leaving the cell |x| < 7.975, 0 < y < 16.7, and the capillary
+  |x| < r_cap = 0.775 from the cell roof to its exit at y = 33.7;
 * the cryostat box (-25, 25) x (-10, 120) with COOLER walls, helium up to y = 23 at t = 0,
   hydrostatic;
 * the superleak band y = 1 +- 2 across |x| <= 15 (:mod:`sphgen.equations.superfluid_fountain`),
-  the heater at (0, 8) with H = 2 (support radius 4), ramped over 0.02 s.
+  the heater at (0, 8) with H = 2 (support radius 4), ramped over 0.02 s;
+* the walls' density constants calibrated as if wet, their pressure floored at 0.
 
 Presets: ``paper`` (dr = r_cap/8, about 200 000 particles, t = 0.3 s; the thesis' run) and
 ``quick`` (dr = r_cap, 2 particles across the capillary, ``--tf`` 0.12 s).  ``post_process`` writes results.json: the mass
