@@ -33,7 +33,7 @@ from sphgen.app import Application
 from sphgen.errors import InputError
 from sphgen.geometry import hexagonal_lattice, inside_disk, inside_rectangle, layers_for_support, perturb
 from sphgen.particles import ParticleArray
-from sphgen.tools.probes import shepard
+from sphgen.tools.probes import pairs_within, shepard
 
 from ..equations.superfluid import ADIABATIC, COOLER, FLUID
 from ..equations.superfluid_energy import HELIUM_1_65K
@@ -92,6 +92,21 @@ def apparatus(dr, n_layers):
     ptype = np.where(fluid, FLUID, np.where(wall, ADIABATIC, COOLER))[keep]
     dry = in_box & ~solid & (y >= LEVEL)   # where fluid may come: the walls' calibration
     return x[keep], y[keep], ptype.astype(np.int32), (x[dry], y[dry])
+
+
+def entropy_flux_across(pa, kernel, y_c, half_width):
+    """The pair entropy flux of eq. 3.34 from below y = y_c to above it, within |x| < half_width:
+    sum over pairs (a above, b below) of -m_a m_b (J_a/rho_a^2 + J_b/rho_b^2) . grad W_ab
+    [W/(m K)] (ADIABATIC pairs carry none); the part of the entropy transport relative to v."""
+    x, y, h = pa.x, pa.y, pa.h
+    near = np.flatnonzero((np.abs(y - y_c) < kernel.radius_scale * h) & (np.abs(x) < half_width))
+    i, j, r = pairs_within((x[near], y[near]), (x[near], y[near]), kernel.radius_scale * h.max())
+    i, j, r = near[i], near[j], r
+    keep = (y[i] > y_c) & (y[j] < y_c) & (r > 0) & (pa.ptype[i] != ADIABATIC) & (pa.ptype[j] != ADIABATIC)
+    i, j, r = i[keep], j[keep], r[keep]
+    dw = np.vectorize(kernel.dwdr, otypes=[float])(r, h[i]) / r
+    f = (pa.jx[i] + pa.jx[j]) * (x[i] - x[j]) + (pa.jy[i] + pa.jy[j]) * (y[i] - y[j])
+    return float(-(pa.m[i] * pa.m[j] * dw * f).sum())
 
 
 class FluxCounter:
@@ -224,6 +239,10 @@ class Fountain(Application):
         if len(hist["rows"]) < 2:
             raise InputError("fountain: fewer than two history rows, nothing to post-process")
         results = summarise(hist)
+        if self.scene is not None:   # the pair entropy flux J at the end (docs/superfluid.md)
+            pa, k = self.scene.by_name["helium"], self.scheme.kernel
+            results["entropy_flux_J_superleak"] = entropy_flux_across(pa, k, SUPERLEAK["y_sl"], 7.9 * MM)
+            results["entropy_flux_J_capillary"] = entropy_flux_across(pa, k, 25.0 * MM, R_CAP + 0.5 * self.dr)
         io.write_json(os.path.join(outdir, "results.json"), results)
         plot(outdir, hist, results)
         print(f"fountain: W = {hist['power']:g} W/m, {hist['preset']} (r_cap/dr = {hist['ratio']:g}), "

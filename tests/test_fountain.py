@@ -139,6 +139,8 @@ def test_quick_preset_few_steps(short):
     assert np.all(cols["crossed"] == 0) and res["flux"] == 0.0
     assert 0.0 < res["dT_cell"] < 1e-3
     assert res["mass_drift"] == 0.0
+    # nothing flows yet: the pair entropy fluxes through the superleak and the capillary are small
+    assert abs(res["entropy_flux_J_capillary"]) < 1e-3 and np.isfinite(res["entropy_flux_J_superleak"])
     # the heat received went into the fluid: sum m s grew by about the heat over T0
     energy_in = np.sum(np.diff(np.concatenate([[0.0], cols["t"]])) * cols["heater_power"])
     assert cols["entropy"][-1] > cols["entropy"][0]
