@@ -171,3 +171,32 @@ def test_paper_preset_flux_within_5_percent_of_eq_3_56(tmp_path, power):
     with open(out / "results.json") as f:
         res = json.load(f)
     assert abs(res["flux_error"]) < 0.05, res
+
+
+def test_compiled_matches_python_evaluator():
+    """Three steps of the fountain scheme (heater on, superleak band across the cloud, gravity,
+    beta, mu, ADIABATIC and COOLER particles): generated code = Python evaluator to round-off."""
+    from test_superfluid import M, cloud
+
+    from sphgen.scene import Scene
+    from sphgen.schemes.superfluid_fountain import FountainScheme
+    from sphgen.solver import Solver
+    runs = []
+    for backend in ("cython", "python"):
+        pa, dx = cloud(nx=8, adiabatic=0.2, cooler=0.1, seed=5, vamp=0.1)
+        sch = FountainScheme(["helium"], model=M, h=1.5 * dx, beta=1.0, mu=1e-4, gravity=(0.0, -9.8, 0.0),
+                             calibrate_density=False,
+                             heater=dict(x_heat=0.5e-3, y_heat=0.5e-3, H=0.2e-3, power=50.0, t_ramp=1e-9),
+                             superleak=dict(k0=1e6, y_sl=0.3e-3, d_sl=0.2e-3, r_sl=0.6e-3))
+        sch.setup_properties([pa])
+        integ = sch.get_integrator()
+        sc = Scene([pa], sch.get_equations(), steppers=integ.steppers, kernel=sch.kernel, dim=2,
+                   outputs={"helium": list(sch.output_props)}, backend=backend, threads=1)
+        Solver(sc, integ, dt=0.4 * 1.5 * dx / M.c1, tf=1.0, max_steps=3, progress=False).run()
+        runs.append(pa)
+    a, b = runs
+    oa, ob = np.argsort(a.gid), np.argsort(b.gid)
+    for p in ("x", "y", "u", "v", "us", "vs", "s", "rho", "p", "T", "sdot", "qheat", "au", "avs"):
+        x, y = a.get(p)[oa], b.get(p)[ob]
+        assert np.abs(x - y).max() <= 1e-12 * np.abs(y).max(), p
+    assert np.abs(a.qheat).max() > 0 and (a.p[a.ptype != FLUID] >= 0).all()
