@@ -145,8 +145,8 @@ class Fountain(Application):
 
     def add_user_options(self, group):
         group.add_argument("--preset", choices=sorted(PRESETS), default="paper",
-                           help="paper: dr = r_cap/8 (143 000 particles), t = 0.3 s; quick: "
-                           "dr = r_cap (3 400 particles), t = 0.12 s (default %(default)s)")
+                           help="paper: dr = r_cap/8 (149 195 particles), t = 0.3 s; quick: "
+                           "dr = r_cap (4 049 particles), t = 0.12 s (default %(default)s)")
         group.add_argument("--power", type=float, default=80.0,
                            help="heater power W_dot [W/m] (the thesis: 60, 80, 100; default %(default)s)")
         group.add_argument("--ratio", type=float, default=None, help="r_cap/dr (default: the preset's)")
