@@ -160,6 +160,7 @@ class SuperfluidVerlet(Integrator):
             return self._symmetric_step(t, dt)
         self.stage("stage1", t, dt)
         self.stage("stage2", t, dt)
+        self.sources(t, dt)
         self.update_nnps()
         self.compute_accelerations(0, t + 0.5 * dt, dt)
         self.stage("stage3", t, dt)
@@ -167,6 +168,9 @@ class SuperfluidVerlet(Integrator):
         self.update_nnps()
         self.compute_accelerations(1, t + dt, dt)
         self.stage("stage1", t + dt, dt)
+
+    def sources(self, t, dt):
+        """Local source stages after the first drift (none here; the fountain's superleak)."""
 
     def _iterate(self, what, evaluate, stage, props, t, dt):
         """Fixed-point iterations: ``evaluate()``, then ``stage``, until ``props`` change by
