@@ -99,6 +99,11 @@ class OscillatingPlate(Application):
                            help="the free-surface treatment of the shifting (sections 3.4-3.5; "
                            "default on for ctvf, off for gtvf)")
         group.add_argument("--no-free-surface", dest="free_surface", action="store_false")
+        group.add_argument("--surface-pressure", action="store_true",
+                           help="hold p = 0 on free-surface particles (not in the paper; the first "
+                           "author's later code does it)")
+        group.add_argument("--edac-damping", choices=("paper", "consistent"), default="paper",
+                           help="ctvf: EDAC damping as printed in eq. 26 (default) or dimensionally consistent")
         group.add_argument("--vf", type=float, default=0.05, help="V_f: tip speed / c0 (default %(default)s)")
         group.add_argument("--length", type=float, default=0.2, help="L (default %(default)s m)")
         group.add_argument("--height", type=float, default=0.02, help="H (default %(default)s m)")
@@ -126,6 +131,8 @@ class OscillatingPlate(Application):
         self.c0, _ = elastic_constants(E, POISSON, RHO0)
         self.shifting = o.shifting or ("spst" if o.scheme == "ctvf" else "gtvf")
         self.free_surface = (o.scheme == "ctvf") if o.free_surface is None else o.free_surface
+        if o.surface_pressure and not self.free_surface:
+            raise InputError("--surface-pressure needs the free-surface treatment")
         self._next_record = 0.0
         self._snap = None
 
@@ -153,17 +160,20 @@ class OscillatingPlate(Application):
     def create_scheme(self):
         o = self.options
         common = dict(h=self.dx, dx=self.dx, umax=o.vf * self.c0, shifting=self.shifting, alpha=o.alpha,
-                      clamped={"plate": self.clamp_gids}, free_surface=self.free_surface)
+                      clamped={"plate": self.clamp_gids}, free_surface=self.free_surface,
+                      surface_pressure=o.surface_pressure)
         if o.scheme == "gtvf":
             return GTVFSolidScheme(["plate"], 2, RHO0, E, POISSON, **common)
         corrections = () if o.no_corrections else SOLID_CORRECTIONS
-        return CTVFSolidScheme(["plate"], 2, RHO0, E, POISSON, corrections=corrections, **common)
+        return CTVFSolidScheme(["plate"], 2, RHO0, E, POISSON, corrections=corrections,
+                               edac_damping=o.edac_damping, **common)
 
     def history_meta(self):
         o = self.options
         return {"dx": self.dx, "scheme": o.scheme, "shifting": self.shifting, "vf": o.vf, "length": o.length,
                 "height": o.height, "nh": o.nh, "c0": self.c0, "free_surface": self.free_surface,
-                "corrections": not o.no_corrections, "sparse_initial": self.sparse0}
+                "corrections": not o.no_corrections, "sparse_initial": self.sparse0,
+                "surface_pressure": o.surface_pressure, "edac_damping": o.edac_damping}
 
     # ------------------------------------------------------------ samples
     def separation(self, pa):

@@ -456,10 +456,18 @@ class CTVFSolidScheme(ElasticSolids, CTVFScheme):
     time step eq. 62 (``umax`` is the largest expected speed).  ``corrections``: subset of
     :data:`SOLID_CORRECTIONS`.  ``free_surface`` (default on): the surface treatment of
     sections 3.4-3.5 as for fluids.  ``clamped``: {array: gids} held fixed.
+    ``edac_damping``: 'paper' (default) is the printed eq. 26, whose damping term carries
+    an extra 1/rho against the Laplacian (nu_edac / rho0 here: rho stays within 1% of
+    rho0); 'consistent' is the fluid scheme's form.  For rho0 = 1000 the consistent
+    damping diffuses the bending pressure across a plate within a fraction of a period
+    and makes it far too soft (docs/ctvf.md).
     """
 
     def __init__(self, solids, dim, rho0, E, poisson, h, dx, umax=1.0, shifting="spst", alpha=1.0,
-                 corrections=SOLID_CORRECTIONS, clamped=None, free_surface=True, **kw):
+                 corrections=SOLID_CORRECTIONS, clamped=None, free_surface=True, edac_damping="paper", **kw):
+        if edac_damping not in ("paper", "consistent"):
+            raise ValueError(f"edac_damping must be 'paper' or 'consistent', got {edac_damping!r}")
+        self.edac_damping = edac_damping
         bad = sorted(set(corrections) - set(SOLID_CORRECTIONS))
         if bad:
             raise ValueError(f"unknown solid correction {bad[0]!r}; known: {', '.join(SOLID_CORRECTIONS)}")
@@ -470,3 +478,8 @@ class CTVFSolidScheme(ElasticSolids, CTVFScheme):
                          corrections=fluid_corrections, density="continuity", alpha=alpha,
                          free_surface=free_surface and shifting != "ipst", **kw)
         self._init_solid(G, clamped or {}, "jaumann" in corrections)
+
+    def nu_edac(self):
+        """Eq. 24, divided by rho0 for the printed form of eq. 26 (``edac_damping='paper'``)."""
+        nu = super().nu_edac()
+        return nu / self.rho0 if self.edac_damping == "paper" else nu
