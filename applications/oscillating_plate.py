@@ -14,10 +14,12 @@ gtvf (its homogenisation, Fig. 18a; ``--shifting spst`` for Fig. 18b).
 centre line, followed by id: :class:`sphgen.tools.probes.MaterialPoints`) from its zero
 crossings, beside the paper's CTVF value 0.284 s (Table 1, V_f = 0.05) and the thin-plate
 value; and the separation measures over the run and up to ``--separation-time``
-(0.22 s, Figs. 18-19): the number of pieces (particles joined when closer than 1.5 dx),
-the largest stretch of an initial nearest-neighbour bond (in dx) and the particles with
-fewer than half the bulk's neighbours within 2.5 dx, beyond the initial count (the
-lattice's corners).  Plots: tip.png (y_tip(t)), plate.png (the particles at the
+(0.22 s, Figs. 18-19): the bond gap, the largest empty disc centred at the midpoint of
+an initial nearest-neighbour pair (in dx: 0.5 on the lattice, 1 with a particle missing;
+the plate counts as separated from 1 dx on), the number of pieces (particles joined
+when closer than 1.5 dx), the largest stretch of an initial bond (in dx) and the
+particles with fewer than half the bulk's neighbours within 2.5 dx, beyond the initial
+count (the lattice's corners).  Plots: tip.png (y_tip(t)), plate.png (the particles at the
 separation time and at the end, coloured by the pressure).
 """
 import math
@@ -30,7 +32,7 @@ from sphgen.app import Application
 from sphgen.errors import InputError
 from sphgen.geometry import rectangle
 from sphgen.particles import ParticleArray
-from sphgen.tools.probes import MaterialPoints, count_neighbours, pairs_within
+from sphgen.tools.probes import MaterialPoints, count_neighbours, nearest_distance, pairs_within
 
 from ..equations.shifting import SHIFTINGS
 from ..schemes.ctvf import SOLID_CORRECTIONS, CTVFSolidScheme, elastic_constants
@@ -44,6 +46,7 @@ PERIOD_PAPER = {0.001: 0.284, 0.01: 0.283, 0.03: 0.283, 0.05: 0.284}
 SCHEMES = ("ctvf", "gtvf")
 BOND = 1.5            # bond / piece radius, in dx
 NEIGHBOUR_RADIUS = 2.5
+GAP_CRACK = 1.0       # bond gap (in dx) of a separation: a hole a whole particle fits into
 
 
 def mode_shape(x, length, kl=KL):
@@ -85,7 +88,7 @@ class OscillatingPlate(Application):
     tf = 0.3
     pfreq = 5000
     dim = 2
-    history_columns = ("t", "y_tip", "pieces", "bond_stretch", "sparse", "kinetic_energy")
+    history_columns = ("t", "y_tip", "pieces", "bond_stretch", "bond_gap", "sparse", "kinetic_energy")
     error_key = "period_error"
 
     def add_user_options(self, group):
@@ -177,12 +180,17 @@ class OscillatingPlate(Application):
 
     # ------------------------------------------------------------ samples
     def separation(self, pa):
-        """(pieces, largest bond stretch / dx, sparse particles beyond the initial count)."""
+        """(pieces, largest bond stretch / dx, bond gap / dx, sparse particles beyond the
+        initial count).  The bond gap is the largest empty disc centred at the midpoint of
+        an initial nearest-neighbour pair: 0.5 dx on the lattice, 1 dx where a particle is
+        missing; a crack opens it wider."""
         order = np.argsort(pa.gid)
         x, y = pa.x[order], pa.y[order]
         a, b = self.bonds.T
         stretch = float(np.hypot(x[a] - x[b], y[a] - y[b]).max() / self.dx)
-        return pieces(x, y, BOND * self.dx), stretch, sparse_particles(x, y, self.dx) - self.sparse0
+        gap = float(nearest_distance((0.5 * (x[a] + x[b]), 0.5 * (y[a] + y[b])), (x, y), 4 * self.dx).max())
+        return (pieces(x, y, BOND * self.dx), stretch, gap / self.dx,
+                sparse_particles(x, y, self.dx) - self.sparse0)
 
     def post_step(self, solver):
         pa = self.scene.by_name["plate"]
@@ -200,15 +208,15 @@ class OscillatingPlate(Application):
     # ------------------------------------------------------------ results
     def post_process(self, outdir):
         hist, rows = io.read_history(outdir)
-        t, y_tip, npieces, stretch, sparse, ke = rows.T
+        t, y_tip, npieces, stretch, gap, sparse, ke = rows.T
         period, how = measured_period(t, y_tip)
         vf, length, height = hist["vf"], hist["length"], hist["height"]
         paper = PERIOD_PAPER.get(vf) if abs(length - 0.2) < 1e-12 and abs(height - 0.02) < 1e-12 else None
         upto = t <= self.options.separation_time + 1e-9
         sep = dict(pieces_max=int(npieces.max()), bond_stretch_max=float(stretch.max()),
-                   sparse_max=int(sparse.max()))
+                   bond_gap_max=float(gap.max()), sparse_max=int(sparse.max()))
         sep_t = dict(pieces_max=int(npieces[upto].max()), bond_stretch_max=float(stretch[upto].max()),
-                     sparse_max=int(sparse[upto].max()))
+                     bond_gap_max=float(gap[upto].max()), sparse_max=int(sparse[upto].max()))
         results = {
             "t": float(t[-1]), "scheme": hist["scheme"], "shifting": hist["shifting"], "vf": vf,
             "dx": hist["dx"], "free_surface": hist["free_surface"], "corrections": hist["corrections"],
@@ -218,8 +226,8 @@ class OscillatingPlate(Application):
             "tip_max": float(y_tip.max()), "tip_min": float(y_tip.min()),
             "separation": sep, "separation_time": self.options.separation_time,
             "separation_upto": sep_t,
-            "separated_upto": bool(sep_t["pieces_max"] > 1 or sep_t["sparse_max"] > 0),
-            "separated": bool(sep["pieces_max"] > 1 or sep["sparse_max"] > 0),
+            "separated_upto": bool(sep_t["pieces_max"] > 1 or sep_t["bond_gap_max"] >= GAP_CRACK),
+            "separated": bool(sep["pieces_max"] > 1 or sep["bond_gap_max"] >= GAP_CRACK),
             "kinetic_energy_final_over_initial": float(ke[-1] / ke[0]) if ke[0] > 0 else None,
         }
         io.write_json(os.path.join(outdir, "results.json"), results)
@@ -227,8 +235,8 @@ class OscillatingPlate(Application):
         p = "n/a" if period is None else f"{period:.4g} s ({how})"
         print(f"oscillating_plate: {hist['scheme']}+{hist['shifting']} t={t[-1]:.4g}  period {p} (paper {paper}, "
               f"thin plate {results['period_thin_plate']:.4g})  up to t={self.options.separation_time:g}: "
-              f"pieces {sep_t['pieces_max']}, bond stretch {sep_t['bond_stretch_max']:.3g} dx, sparse "
-              f"{sep_t['sparse_max']}\nresults: {os.path.join(outdir, 'results.json')}")
+              f"pieces {sep_t['pieces_max']}, bond gap {sep_t['bond_gap_max']:.3g} dx, bond stretch "
+              f"{sep_t['bond_stretch_max']:.3g} dx, sparse {sep_t['sparse_max']}\nresults: {os.path.join(outdir, 'results.json')}")
         return results
 
     def plot(self, outdir, t, y_tip, hist):

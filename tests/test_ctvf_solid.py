@@ -281,7 +281,8 @@ def test_coarse_plate_bends_from_the_clamp(tmp_path):
     pa = app.scene.by_name["plate"]
     held = np.isin(pa.gid, app.clamp_gids)
     assert held.sum() == 3 * 4 and np.all(pa.x[held] < 0) and np.all(pa.v[held] == 0)
-    assert res["separation"]["pieces_max"] == 1
+    assert res["separation"]["pieces_max"] == 1 and 0.5 <= res["separation"]["bond_gap_max"] < 1.0
+    assert not res["separated"]
     assert res["period"] is None            # not a full period yet
 
 
