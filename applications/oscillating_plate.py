@@ -32,6 +32,7 @@ from sphgen.app import Application
 from sphgen.errors import InputError
 from sphgen.geometry import rectangle
 from sphgen.particles import ParticleArray
+from sphgen.tools.plots import particle_panels
 from sphgen.tools.probes import MaterialPoints, count_neighbours, nearest_distance, pairs_within
 
 from ..equations.shifting import SHIFTINGS
@@ -259,14 +260,7 @@ class OscillatingPlate(Application):
         if self.scene is not None:
             pa = self.scene.by_name["plate"]
             snaps.append((float(t[-1]), pa.x, pa.y, pa.p))
-        if not snaps:
-            return
-        fig, axes = plt.subplots(len(snaps), 1, figsize=(8, 2.6 * len(snaps)), squeeze=False)
-        for ax, (ts, x, y, p) in zip(axes[:, 0], snaps):
-            sc = ax.scatter(x, y, c=p, s=3, cmap="jet")
-            fig.colorbar(sc, ax=ax, label="p [Pa]")
-            ax.set_aspect("equal")
-            ax.set_title(f"{hist['scheme'].upper()} + {hist['shifting'].upper()}, t = {ts:.3g} s", fontsize=9)
-        fig.tight_layout()
-        fig.savefig(os.path.join(outdir, "plate.png"), dpi=110)
-        plt.close(fig)
+        if snaps:
+            name = f"{hist['scheme'].upper()} + {hist['shifting'].upper()}"
+            particle_panels(os.path.join(outdir, "plate.png"),
+                            [(f"{name}, t = {ts:.3g} s", x, y, p) for ts, x, y, p in snaps])

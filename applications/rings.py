@@ -29,6 +29,7 @@ from sphgen.app import Application
 from sphgen.errors import InputError
 from sphgen.geometry import annulus, vertex_lattice
 from sphgen.particles import ParticleArray
+from sphgen.tools.plots import particle_panels
 from sphgen.tools.probes import MaterialPoints
 
 from ..equations.shifting import SHIFTINGS
@@ -198,11 +199,5 @@ class Rings(Application):
         plt.close(fig)
         if self.scene is not None:
             pa = self.scene.by_name["rings"]
-            fig, ax = plt.subplots(figsize=(8, 4))
-            sc = ax.scatter(pa.x, pa.y, c=pa.p, s=1, cmap="jet")
-            fig.colorbar(sc, ax=ax, label="p [Pa]")
-            ax.set_aspect("equal")
-            ax.set_title(f"t = {rows[-1, 0] * 1e3:.3g} ms", fontsize=9)
-            fig.tight_layout()
-            fig.savefig(os.path.join(outdir, "rings.png"), dpi=110)
-            plt.close(fig)
+            particle_panels(os.path.join(outdir, "rings.png"),
+                            [(f"t = {rows[-1, 0] * 1e3:.3g} ms", pa.x, pa.y, pa.p)], size=(8.0, 4.0), marker=1)

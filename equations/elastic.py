@@ -8,6 +8,7 @@ even in 2D: plane strain keeps sigma'_zz), its rate ``asd``, the velocity gradie
 schemes evolve it (EDAC, eq. 26) or take it from an equation of state.
 """
 from sphgen.equation import Equation, declare  # noqa: F401  (declare: the Python evaluator)
+from sphgen.linalg import dev3
 
 
 class VelocityGradient(Equation):
@@ -68,10 +69,7 @@ class HookeJaumannRate(Equation):
                 gji = d_gradv[9 * d_idx + 3 * j + i]
                 eps[3 * i + j] = 0.5 * (gij + gji)
                 om[3 * i + j] = 0.5 * (gij - gji)
-        tr = (eps[0] + eps[4] + eps[8]) / 3.0
-        eps[0] -= tr
-        eps[4] -= tr
-        eps[8] -= tr
+        dev3(eps, eps)
         for i in range(3):
             for j in range(3):
                 rot = 0.0
