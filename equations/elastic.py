@@ -7,6 +7,8 @@ even in 2D: plane strain keeps sigma'_zz), its rate ``asd``, the velocity gradie
 ``gradv`` ((grad u)_ij = du_i/dx_j at ``gradv[3 i + j]``).  The pressure is not here: the
 schemes evolve it (EDAC, eq. 26) or take it from an equation of state.
 """
+from math import sqrt  # noqa: F401  (the Python evaluator needs the name)
+
 from sphgen.equation import Equation, declare  # noqa: F401  (declare: the Python evaluator)
 from sphgen.linalg import dev3
 
@@ -121,3 +123,29 @@ class DeviatoricStressForce(Equation):
         d_au[d_idx] += f[0]
         d_av[d_idx] += f[1]
         d_aw[d_idx] += f[2]
+
+
+class PerfectPlasticity(Equation):
+    """sigma' <- beta sigma', beta = min(sqrt(Y0^2 / (3 J2)), 1), J2 = sigma':sigma' / 2: elastic,
+    perfectly plastic von Mises (Adepu & Ramachandran 2021, section 4.7, with the square
+    root of the radial return; ``literal=True`` takes beta = min(Y0^2 / (3 J2), 1) as
+    printed).  No sources: run it on the updated stress, before the momentum equation."""
+
+    positive = ("yield_stress",)
+    switches = ("literal",)
+
+    def __init__(self, dest, sources=None, yield_stress=1.0, literal=False):
+        super().__init__(dest, None, yield_stress=yield_stress, literal=bool(literal))
+
+    def initialize(self, d_idx, d_sd):
+        j2 = 0.0
+        for i in range(9):
+            j2 += d_sd[9 * d_idx + i] * d_sd[9 * d_idx + i]
+        j2 = 0.5 * j2
+        if j2 > 0.0:
+            f = self.yield_stress * self.yield_stress / (3.0 * j2)
+            if not self.literal:
+                f = sqrt(f)
+            if f < 1.0:
+                for i in range(9):
+                    d_sd[9 * d_idx + i] *= f

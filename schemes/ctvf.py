@@ -34,7 +34,7 @@ from ..equations.ctvf import (ContinuityTransportCorrection, EDACTransportCorrec
                               MomentumTransportDivergence)
 from ..equations.edac import EDACPressureRate
 from ..equations.elastic import (DeviatoricStressForce, HookeJaumannRate, JaumannTransportCorrection,
-                                 VelocityGradient)
+                                 PerfectPlasticity, VelocityGradient)
 from ..equations.free_surface import (SurfacePressure, SurfaceShiftingFilter, free_surface_groups,
                                       setup_free_surface_properties)
 from ..equations.momentum import ArtificialViscosity, AveragePressure, LaminarViscosity, PressureGradient
@@ -374,12 +374,13 @@ class ElasticSolids:
     the momentum group is eq. 30 (pressure, deviatoric stress, Monaghan artificial
     viscosity with beta = 0, body force, homogenisation); the drift evolves ``sd``
     (eq. 58); ``clamped`` ({array: gids}) particles are held at u = u~ = 0 by the
-    integrator after every stage.  Mix in before the scheme class."""
+    integrator after every stage; ``yield_stress`` Y0 (if given) limits the updated
+    stress to the von Mises surface (section 4.7).  Mix in before the scheme class."""
 
     transport_gradient = False
     output_props = ("x", "y", "z", "u", "v", "w", "p", "rho", "m", "h", "sd")
 
-    def _init_solid(self, G, clamped, jaumann_correction):
+    def _init_solid(self, G, clamped, jaumann_correction, yield_stress=None):
         if self.walls:
             raise ValueError(f"{type(self).__name__}: wall arrays for solids (stress extrapolation, eq. 53) "
                              "are not implemented; hold boundary particles with clamped={array: gids}")
@@ -391,11 +392,14 @@ class ElasticSolids:
         if bad:
             raise ValueError(f"{type(self).__name__}: clamped array {bad[0]!r} is not among {self.fluids}")
         self.jaumann_correction = bool(jaumann_correction) and self.shift.active
+        if yield_stress is not None and not yield_stress > 0:
+            raise ValueError(f"{type(self).__name__}: yield_stress={yield_stress!r} must be > 0")
+        self.yield_stress = yield_stress
 
     def parameters(self):
         out = super().parameters()
         out.update(G=self.G, transport_gradient=self.transport_gradient,
-                   jaumann_correction=self.jaumann_correction)
+                   jaumann_correction=self.jaumann_correction, yield_stress=self.yield_stress)
         return out
 
     def setup_properties(self, arrays):
@@ -428,6 +432,8 @@ class ElasticSolids:
 
     def get_equations(self):
         first, second = super().get_equations()
+        if self.yield_stress is not None:     # on the stress the drift updated (eq. 58)
+            second = [Group([PerfectPlasticity(d, yield_stress=self.yield_stress) for d in self.fluids])] + second
         return [list(first) + self._stress_rate_groups(), second]
 
     def get_integrator(self):
@@ -464,7 +470,8 @@ class CTVFSolidScheme(ElasticSolids, CTVFScheme):
     """
 
     def __init__(self, solids, dim, rho0, E, poisson, h, dx, umax=1.0, shifting="spst", alpha=1.0,
-                 corrections=SOLID_CORRECTIONS, clamped=None, free_surface=True, edac_damping="paper", **kw):
+                 corrections=SOLID_CORRECTIONS, clamped=None, free_surface=True, edac_damping="paper",
+                 yield_stress=None, **kw):
         if edac_damping not in ("paper", "consistent"):
             raise ValueError(f"edac_damping must be 'paper' or 'consistent', got {edac_damping!r}")
         self.edac_damping = edac_damping
@@ -477,7 +484,7 @@ class CTVFSolidScheme(ElasticSolids, CTVFScheme):
         super().__init__(solids, dim, rho0, c0, 0.0, h, dx, umax=umax, shifting=shifting,
                          corrections=fluid_corrections, density="continuity", alpha=alpha,
                          free_surface=free_surface and shifting != "ipst", **kw)
-        self._init_solid(G, clamped or {}, "jaumann" in corrections)
+        self._init_solid(G, clamped or {}, "jaumann" in corrections, yield_stress)
 
     def nu_edac(self):
         """Eq. 24, divided by rho0 for the printed form of eq. 26 (``edac_damping='paper'``)."""
