@@ -130,6 +130,8 @@ class TransportVelocityScheme(Scheme):
     ``walls``: names of wall arrays (fixed particles with ``m``, ``h``, ``rho`` and unit
     ``normal`` into the fluid, stride 3); ``moving_walls``: those among them with a
     prescribed velocity ``uw, vw, ww`` (Adepu & Ramachandran 2021, section 3.6).
+    ``free_surface``, ``surface_pressure``, ``cone_radius``: the free-surface treatment
+    of sections 3.4-3.5 (see :class:`CTVFScheme`), shared by every transport scheme.
     """
 
     output_props = ("x", "y", "z", "u", "v", "w", "p", "rho", "m", "h")
@@ -466,7 +468,8 @@ class CTVFSolidScheme(ElasticSolids, CTVFScheme):
     an extra 1/rho against the Laplacian (nu_edac / rho0 here: rho stays within 1% of
     rho0); 'consistent' is the fluid scheme's form.  For rho0 = 1000 the consistent
     damping diffuses the bending pressure across a plate within a fraction of a period
-    and makes it far too soft (docs/ctvf.md).
+    and makes it far too soft (docs/ctvf.md).  ``yield_stress``: Y0 of the elastic,
+    perfectly plastic limiter (section 4.7; None: elastic).
     """
 
     def __init__(self, solids, dim, rho0, E, poisson, h, dx, umax=1.0, shifting="spst", alpha=1.0,
