@@ -13,7 +13,14 @@ Walls (section 3.6): Adami et al. (2012) ghost particles (``walls``, ``moving_wa
 the free-slip ghost velocities of eqs. 46-49 in every divergence term (they are the walls'
 ``u, v, w`` and ``uhat, vhat, what``, :class:`~sphgen.equations.transport_walls.WallSlipVelocity`)
 and the no-slip ghost velocity of eq. 50 in the viscous term; pressure extrapolated by
-eq. 52 and the wall density from the linear equation of state.  Solids enter later.
+eq. 52 and the wall density from the linear equation of state.
+
+Elastic solids (section 3.2): :class:`CTVFSolidScheme`, the same continuity (eq. 25), EDAC
+(eq. 26), shifting and integrator, with the momentum equation eq. 30 (no A term), the
+velocity gradient of the momentum velocity (eq. 31) and the Jaumann rate with its
+transport correction (eq. 32); the pieces solids add to any transport-velocity scheme are
+the mixin :class:`ElasticSolids` (the GTVF solid of ``schemes/gtvf.py`` uses it too).
+Clamped particles are held by the integrator's prescribed values (``clamped``).
 """
 from math import sqrt
 
@@ -26,6 +33,8 @@ from ..equations.basic import SummationDensity, Vorticity2D
 from ..equations.ctvf import (ContinuityTransportCorrection, EDACTransportCorrection,
                               MomentumTransportDivergence)
 from ..equations.edac import EDACPressureRate
+from ..equations.elastic import (DeviatoricStressForce, HookeJaumannRate, JaumannTransportCorrection,
+                                 PerfectPlasticity, VelocityGradient)
 from ..equations.free_surface import (SurfacePressure, SurfaceShiftingFilter, free_surface_groups,
                                       setup_free_surface_properties)
 from ..equations.momentum import ArtificialViscosity, AveragePressure, LaminarViscosity, PressureGradient
@@ -38,18 +47,21 @@ from ..equations.wcsph import BodyForce
 
 DENSITIES = ("summation", "continuity")
 CORRECTIONS = ("edac", "stress", "divergence", "continuity")
+SOLID_CORRECTIONS = ("edac", "continuity", "jaumann")
 
 
 class TransportVelocityStep(IntegratorStep):
     """Kick-drift-kick stages with the transport velocity (Adepu & Ramachandran 2021,
     eqs. 54-60).  Switches: ``shift`` (move with u~, else with u), ``pressure`` (evolve p
-    by dp/dt, eq. 57), ``density`` (evolve rho by drho/dt, eq. 56)."""
+    by dp/dt, eq. 57), ``density`` (evolve rho by drho/dt, eq. 56), ``stress`` (evolve the
+    deviatoric stress ``sd`` by ``asd``, eq. 58: elastic solids)."""
 
-    switches = ("dim", "shift", "pressure", "density")
+    switches = ("dim", "shift", "pressure", "density", "stress")
 
-    def __init__(self, dim, shift=True, pressure=True, density=False):
+    def __init__(self, dim, shift=True, pressure=True, density=False, stress=False):
         self.dim, self.shift = int(dim), int(bool(shift))
         self.pressure, self.density = int(bool(pressure)), int(bool(density))
+        self.stress = int(bool(stress))
 
     def stage1(self, d_idx, d_u, d_v, d_w, d_au, d_av, d_aw, d_uhat, d_vhat, d_what,
                d_auhat, d_avhat, d_awhat, dt):
@@ -67,8 +79,12 @@ class TransportVelocityStep(IntegratorStep):
                 d_what[d_idx] = d_w[d_idx] + 0.5 * dt * d_awhat[d_idx]
 
     def stage2(self, d_idx, d_x, d_y, d_z, d_u, d_v, d_w, d_uhat, d_vhat, d_what, d_p, d_ap,
-               d_rho, d_arho, dt):
-        """Drift: density (eq. 56), pressure (eq. 57), positions with u~^{n+1/2} (eq. 59)."""
+               d_rho, d_arho, d_sd, d_asd, dt):
+        """Drift: density (eq. 56), pressure (eq. 57), deviatoric stress (eq. 58), positions
+        with u~^{n+1/2} (eq. 59)."""
+        if self.stress:
+            for i in range(9):
+                d_sd[9 * d_idx + i] += dt * d_asd[9 * d_idx + i]
         if self.pressure:
             d_p[d_idx] += dt * d_ap[d_idx]
         if self.density:
@@ -114,6 +130,8 @@ class TransportVelocityScheme(Scheme):
     ``walls``: names of wall arrays (fixed particles with ``m``, ``h``, ``rho`` and unit
     ``normal`` into the fluid, stride 3); ``moving_walls``: those among them with a
     prescribed velocity ``uw, vw, ww`` (Adepu & Ramachandran 2021, section 3.6).
+    ``free_surface``, ``surface_pressure``, ``cone_radius``: the free-surface treatment
+    of sections 3.4-3.5 (see :class:`CTVFScheme`), shared by every transport scheme.
     """
 
     output_props = ("x", "y", "z", "u", "v", "w", "p", "rho", "m", "h")
@@ -122,7 +140,8 @@ class TransportVelocityScheme(Scheme):
     def __init__(self, fluids, dim, rho0, c0, nu, h, dx, umax=1.0, shifting="spst",
                  density="summation", alpha=0.0, mach=None, pb=None, p_ref=None,
                  kernel="quintic", gx=0.0, gy=0.0, gz=0.0, ipst_tolerance=0.02,
-                 ipst_max_iterations=10, ipst_interval=1, walls=(), moving_walls=()):
+                 ipst_max_iterations=10, ipst_interval=1, walls=(), moving_walls=(),
+                 free_surface=False, surface_pressure=False, cone_radius=2.0):
         for name, v in (("rho0", rho0), ("c0", c0), ("h", h), ("dx", dx), ("umax", umax)):
             if not v > 0:
                 raise ValueError(f"{type(self).__name__}: {name}={v!r} must be > 0")
@@ -143,6 +162,12 @@ class TransportVelocityScheme(Scheme):
         self.shift = Shifting(shifting, self.dim, h, dx, c0, umax, self.kernel, rho0=rho0, mach=mach,
                               pb=pb, p_ref=p_ref, ipst_tolerance=ipst_tolerance,
                               ipst_max_iterations=ipst_max_iterations, ipst_interval=ipst_interval)
+        if free_surface and self.shift.kind == "ipst":
+            raise ValueError("free surfaces with IPST (eq. 45) are not implemented; use shifting='spst'")
+        if surface_pressure and not free_surface:
+            raise ValueError("surface_pressure needs free_surface=True")
+        self.free_surface, self.surface_pressure = bool(free_surface), bool(surface_pressure)
+        self.cone_radius = cone_radius
         # weak compressibility assumes Mach << 1: a particle at Mach 1 means the run blew up
         self.speed_limit = c0
         skip = {1: ("y", "z", "v", "w"), 2: ("z", "w"), 3: ()}[self.dim]
@@ -160,6 +185,8 @@ class TransportVelocityScheme(Scheme):
                     pa.add_property(p)
             if pa.name in self.fluids:
                 self.shift.setup_properties(pa)
+                if self.free_surface:
+                    setup_free_surface_properties(pa)
             if pa.name in self.walls:
                 for p in ("wij", "ug", "vg", "wg", "uw", "vw", "ww", "uhat", "vhat", "what"):
                     if not pa.has(p):
@@ -201,6 +228,25 @@ class TransportVelocityScheme(Scheme):
                     WallGhostVelocity(w, self.fluids, slip=False, moving=moving, dim=self.dim),
                     WallSlipVelocity(w, self.fluids, moving=moving, dim=self.dim)]
         return [Group(eqs)]
+
+    def _surface_groups(self):
+        """Free-surface particles, normals and h_b (sections 3.4-3.5); [] without."""
+        if not self.free_surface:
+            return []
+        return free_surface_groups(self.fluids, self.walls, rho0=self.rho0, radius=self.cone_radius,
+                                   h_b_factor=self.kernel.radius_scale)
+
+    def _surface_filter_groups(self):
+        """After the homogenisation: eq. 44 near the free surface; [] without."""
+        if self.free_surface and self.shift.active:
+            return [Group([SurfaceShiftingFilter(d) for d in self.fluids])]
+        return []
+
+    def _surface_pressure_groups(self):
+        """p = dp/dt = 0 on free-surface particles (``surface_pressure``); [] without."""
+        if self.surface_pressure:
+            return [Group([SurfacePressure(d) for d in self.fluids])]
+        return []
 
     def _body_force(self, dest):
         if self.gx or self.gy or self.gz:
@@ -254,15 +300,8 @@ class CTVFScheme(TransportVelocityScheme):
     """
 
     def __init__(self, fluids, dim, rho0, c0, nu, h, dx, umax=1.0, shifting="spst",
-                 corrections=CORRECTIONS, alpha_edac=0.5, bql=False, free_surface=False,
-                 surface_pressure=False, cone_radius=2.0, **kw):
+                 corrections=CORRECTIONS, alpha_edac=0.5, bql=False, **kw):
         super().__init__(fluids, dim, rho0, c0, nu, h, dx, umax=umax, shifting=shifting, **kw)
-        if free_surface and self.shift.kind == "ipst":
-            raise ValueError("free surfaces with IPST (eq. 45) are not implemented; use shifting='spst'")
-        if surface_pressure and not free_surface:
-            raise ValueError("surface_pressure needs free_surface=True")
-        self.free_surface, self.surface_pressure = bool(free_surface), bool(surface_pressure)
-        self.cone_radius = cone_radius
         bad = sorted(set(corrections) - set(CORRECTIONS))
         if bad:
             raise ValueError(f"unknown correction {bad[0]!r}; known: {', '.join(CORRECTIONS)}")
@@ -272,20 +311,6 @@ class CTVFScheme(TransportVelocityScheme):
         self.stress_correction = "stress" in on
         self.divergence_correction = "divergence" in on
         self.continuity_correction = "continuity" in on and self.density == "continuity"
-
-    def setup_properties(self, arrays):
-        super().setup_properties(arrays)
-        if self.free_surface:
-            for pa in arrays:
-                if pa.name in self.fluids:
-                    setup_free_surface_properties(pa)
-
-    def _surface_groups(self):
-        """Free-surface particles, normals and h_b (sections 3.4-3.5); [] without."""
-        if not self.free_surface:
-            return []
-        return free_surface_groups(self.fluids, self.walls, rho0=self.rho0, radius=self.cone_radius,
-                                   h_b_factor=self.kernel.radius_scale)
 
     def nu_edac(self):
         """nu_edac = alpha_edac h c0 / 8 (Adepu & Ramachandran 2021, eq. 24)."""
@@ -329,9 +354,142 @@ class CTVFScheme(TransportVelocityScheme):
         src = self._sources(self.fluids[0])
         second = (self._density_groups() + self._wall_groups() + self._surface_groups()
                   + [self._momentum_group()] + self.shift.groups(self.fluids, src))
-        first = self._wall_groups() + [self._rate_group()]
-        if self.free_surface and self.shift.active:
-            second.append(Group([SurfaceShiftingFilter(d) for d in self.fluids]))
-        if self.surface_pressure:
-            first.append(Group([SurfacePressure(d) for d in self.fluids]))
-        return [first, second]
+        first = self._wall_groups() + [self._rate_group()] + self._surface_pressure_groups()
+        return [first, second + self._surface_filter_groups()]
+
+
+def elastic_constants(E, poisson, rho0):
+    """(c0, G): c0 = sqrt(E / (3 (1 - 2 nu) rho0)) (Adepu & Ramachandran 2021, section 2) and the
+    shear modulus G = E / (2 (1 + nu))."""
+    if not (E > 0 and rho0 > 0 and -1.0 < poisson < 0.5):
+        raise ValueError(f"elastic constants need E > 0, rho0 > 0, -1 < poisson < 0.5; got E={E!r}, "
+                         f"poisson={poisson!r}, rho0={rho0!r}")
+    return sqrt(E / (3.0 * (1.0 - 2.0 * poisson) * rho0)), E / (2.0 * (1.0 + poisson))
+
+
+class ElasticSolids:
+    """What elastic solids add to a transport-velocity scheme (Adepu & Ramachandran 2021,
+    section 3.2): the media (the scheme's ``fluids``) carry the deviatoric stress ``sd``
+    (stride 9), its rate ``asd`` and the velocity gradient ``gradv``; evaluation 0 adds
+    the velocity gradient (eq. 31; of u~ if ``transport_gradient``, as GTVF) and the
+    Hooke-Jaumann rate (eq. 32, its transport correction when ``jaumann_correction``);
+    the momentum group is eq. 30 (pressure, deviatoric stress, Monaghan artificial
+    viscosity with beta = 0, body force, homogenisation); the drift evolves ``sd``
+    (eq. 58); ``clamped`` ({array: gids}) particles are held at u = u~ = 0 by the
+    integrator after every stage; ``yield_stress`` Y0 (if given) limits the updated
+    stress to the von Mises surface (section 4.7).  Mix in before the scheme class."""
+
+    transport_gradient = False
+    output_props = ("x", "y", "z", "u", "v", "w", "p", "rho", "m", "h", "sd")
+
+    def _init_solid(self, G, clamped, jaumann_correction, yield_stress=None):
+        if self.walls:
+            raise ValueError(f"{type(self).__name__}: wall arrays for solids (stress extrapolation, eq. 53) "
+                             "are not implemented; hold boundary particles with clamped={array: gids}")
+        if not G > 0:
+            raise ValueError(f"{type(self).__name__}: shear modulus G={G!r} must be > 0")
+        self.G = G
+        self.clamped = {a: list(g) for a, g in dict(clamped).items()}
+        bad = sorted(set(self.clamped) - set(self.fluids))
+        if bad:
+            raise ValueError(f"{type(self).__name__}: clamped array {bad[0]!r} is not among {self.fluids}")
+        self.jaumann_correction = bool(jaumann_correction) and self.shift.active
+        if yield_stress is not None and not yield_stress > 0:
+            raise ValueError(f"{type(self).__name__}: yield_stress={yield_stress!r} must be > 0")
+        self.yield_stress = yield_stress
+
+    def parameters(self):
+        out = super().parameters()
+        out.update(G=self.G, transport_gradient=self.transport_gradient,
+                   jaumann_correction=self.jaumann_correction, yield_stress=self.yield_stress)
+        return out
+
+    def setup_properties(self, arrays):
+        super().setup_properties(arrays)
+        for pa in arrays:
+            if pa.name in self.fluids:
+                for p in ("sd", "asd", "gradv"):
+                    if not pa.has(p):
+                        pa.add_property(p, stride=9)
+
+    def _stress_rate_groups(self):
+        """Eq. 31, then eq. 32 (rate and transport correction): evaluation 0."""
+        grad = [VelocityGradient(d, self._sources(d), transport=self.transport_gradient, dim=self.dim)
+                for d in self.fluids]
+        rate = []
+        for d in self.fluids:
+            rate += [HookeJaumannRate(d, G=self.G),
+                     JaumannTransportCorrection(d, self._sources(d), enabled=self.jaumann_correction)]
+        return [Group(grad), Group(rate)]
+
+    def _momentum_group(self):
+        """Eq. 30 with Pi_ab as a pressure-like term (the printed sign would be anti-dissipative)."""
+        eqs = []
+        for d in self.fluids:
+            src = self._sources(d)
+            eqs += [PressureGradient(d, src, bql=False), DeviatoricStressForce(d, src),
+                    ArtificialViscosity(d, src, alpha=self.alpha, c0=self.c0)]
+            eqs += self._body_force(d) + self.shift.momentum_equations(d, src)
+        return Group(eqs)
+
+    def get_equations(self):
+        first, second = super().get_equations()
+        if self.yield_stress is not None:     # on the stress the drift updated (eq. 58)
+            second = [Group([PerfectPlasticity(d, yield_stress=self.yield_stress) for d in self.fluids])] + second
+        return [list(first) + self._stress_rate_groups(), second]
+
+    def get_integrator(self):
+        step = TransportVelocityStep(self.dim, shift=self.shift.active, pressure=self.evolve_pressure,
+                                     density=True, stress=True)
+        integrator = KickDriftKick(**{name: step for name in self.fluids})
+        held = {p: 0.0 for vel in ("u", "v", "w")[:self.dim] for p in (vel, vel + "hat")}
+        for array, gids in self.clamped.items():
+            integrator.clamp(array, gids, **held)
+        return integrator
+
+    def stability_bounds(self, dt):
+        """Eq. 62: dt <= 0.25 h / (c0 + |U|)."""
+        return [Bound("--dt", dt, self.get_timestep(), True,
+                      "0.25 h/(c0 + U), Adepu & Ramachandran eq. 62")]
+
+
+class CTVFSolidScheme(ElasticSolids, CTVFScheme):
+    """CTVF for elastic solids (Adepu & Ramachandran 2021, sections 3.1-3.2).
+
+    ``solids``: the solid arrays; ``E``, ``poisson``, ``rho0``: c0 and G follow
+    (:func:`elastic_constants`).  Pressure by EDAC with its correction (eq. 26), density by
+    the corrected continuity equation (eq. 25), velocity gradient of the momentum velocity
+    (eq. 31), Jaumann rate with its correction (eq. 32), momentum eq. 30 with Monaghan's
+    artificial viscosity ``alpha`` (paper: 1), SPST (default) or IPST, kick-drift-kick,
+    time step eq. 62 (``umax`` is the largest expected speed).  ``corrections``: subset of
+    :data:`SOLID_CORRECTIONS`.  ``free_surface`` (default on): the surface treatment of
+    sections 3.4-3.5 as for fluids.  ``clamped``: {array: gids} held fixed.
+    ``edac_damping``: 'paper' (default) is the printed eq. 26, whose damping term carries
+    an extra 1/rho against the Laplacian (nu_edac / rho0 here: rho stays within 1% of
+    rho0); 'consistent' is the fluid scheme's form.  For rho0 = 1000 the consistent
+    damping diffuses the bending pressure across a plate within a fraction of a period
+    and makes it far too soft (docs/ctvf.md).  ``yield_stress``: Y0 of the elastic,
+    perfectly plastic limiter (section 4.7; None: elastic).
+    """
+
+    def __init__(self, solids, dim, rho0, E, poisson, h, dx, umax=1.0, shifting="spst", alpha=1.0,
+                 corrections=SOLID_CORRECTIONS, clamped=None, free_surface=True, edac_damping="paper",
+                 yield_stress=None, **kw):
+        if edac_damping not in ("paper", "consistent"):
+            raise ValueError(f"edac_damping must be 'paper' or 'consistent', got {edac_damping!r}")
+        self.edac_damping = edac_damping
+        bad = sorted(set(corrections) - set(SOLID_CORRECTIONS))
+        if bad:
+            raise ValueError(f"unknown solid correction {bad[0]!r}; known: {', '.join(SOLID_CORRECTIONS)}")
+        c0, G = elastic_constants(E, poisson, rho0)
+        self.E, self.poisson = E, poisson
+        fluid_corrections = tuple(c for c in corrections if c in ("edac", "continuity"))
+        super().__init__(solids, dim, rho0, c0, 0.0, h, dx, umax=umax, shifting=shifting,
+                         corrections=fluid_corrections, density="continuity", alpha=alpha,
+                         free_surface=free_surface and shifting != "ipst", **kw)
+        self._init_solid(G, clamped or {}, "jaumann" in corrections, yield_stress)
+
+    def nu_edac(self):
+        """Eq. 24, divided by rho0 for the printed form of eq. 26 (``edac_damping='paper'``)."""
+        nu = super().nu_edac()
+        return nu / self.rho0 if self.edac_damping == "paper" else nu

@@ -18,6 +18,12 @@ the baseline the CTVF of Adepu & Ramachandran (2021) improves on.
 No CTVF corrections: no -u div(u~ - u) term, and the pressure follows the density.
 Walls as in the CTVF scheme (Adami et al. 2012 ghost particles, free-slip ghost
 velocities in the continuity and transport terms, no-slip in the viscous term).
+
+Elastic solids: :class:`GTVFSolidScheme` (Zhang, Hu & Adams 2017, section on elastic
+dynamics): the pieces of :class:`~sphgen.schemes.ctvf.ElasticSolids` with the velocity
+gradient of the transport velocity, no correction terms, pressure from p = c0^2 (rho -
+rho0), density by continuity with u~; their homogenisation ('gtvf', Fig. 18a of Adepu &
+Ramachandran 2021) or SPST ('spst', Fig. 18b).
 """
 from sphgen.equation import Group
 
@@ -26,7 +32,7 @@ from ..equations.density import CorrectedSummationDensity, SaveDensity
 from ..equations.momentum import PressureGradient
 from ..equations.transport import TransportContinuity, TransportStress
 from ..equations.wcsph import TaitEOS
-from .ctvf import TransportVelocityScheme
+from .ctvf import ElasticSolids, TransportVelocityScheme, elastic_constants
 
 
 class GTVFScheme(TransportVelocityScheme):
@@ -83,7 +89,32 @@ class GTVFScheme(TransportVelocityScheme):
 
     def get_equations(self):
         src = self._sources(self.fluids[0])
-        second = (self._density_groups() + self._wall_groups() + [self._momentum_group()]
-                  + self.shift.groups(self.fluids, src))
+        second = (self._density_groups() + self._wall_groups() + self._surface_groups()
+                  + [self._momentum_group()] + self.shift.groups(self.fluids, src)
+                  + self._surface_filter_groups())
         rates = self._rate_groups()
         return [(self._wall_groups() + rates) if rates else [], second]
+
+
+class GTVFSolidScheme(ElasticSolids, GTVFScheme):
+    """GTVF for elastic solids (Zhang, Hu & Adams 2017), the baseline of Adepu & Ramachandran
+    (2021), Fig. 18.  ``solids``, ``E``, ``poisson``, ``rho0`` as
+    :class:`~sphgen.schemes.ctvf.CTVFSolidScheme`; ``shifting`` 'gtvf' (their
+    homogenisation, p_ref = rho0 c0^2, the bulk modulus) or 'spst'; ``free_surface``
+    (default off: the original GTVF has no surface detection) adds the surface treatment
+    of the CTVF (sections 3.4-3.5) to the shifting.  Density by continuity with u~ (no
+    summation re-initialisation: a solid with free surfaces), p = c0^2 (rho - rho0)."""
+
+    transport_gradient = True
+
+    def __init__(self, solids, dim, rho0, E, poisson, h, dx, umax=1.0, shifting="gtvf", alpha=1.0,
+                 clamped=None, yield_stress=None, **kw):
+        c0, G = elastic_constants(E, poisson, rho0)
+        self.E, self.poisson = E, poisson
+        super().__init__(solids, dim, rho0, c0, 0.0, h, dx, umax=umax, shifting=shifting,
+                         density="continuity", alpha=alpha, **kw)
+        self._init_solid(G, clamped or {}, False, yield_stress)
+
+    def _density_groups(self):
+        """p = c0^2 (rho - rho0), rho from the continuity equation."""
+        return [Group([TaitEOS(d, rho0=self.rho0, c0=self.c0, gamma=1.0) for d in self.fluids])]

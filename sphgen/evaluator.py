@@ -35,6 +35,10 @@ class PythonEvaluator(Backend):
             return pa.data[name]
         if name in pa.constants:
             return pa.constants[name]
+        if name not in pa.props:
+            # not even declared: an argument a switched-off branch uses (the compiled
+            # stage drops it); a real use fails at once on None
+            return None
         # a store the generator removed as dead: give it scratch memory
         key = (pa.name, name)
         if key not in self._scratch:

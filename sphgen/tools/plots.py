@@ -28,3 +28,20 @@ def plot_series(json_path, png_path):
     fig.savefig(png_path, dpi=90)
     plt.close(fig)
     return png_path
+
+
+def particle_panels(png_path, panels, label="p [Pa]", size=(8.0, 2.6), marker=3):
+    """Particles coloured by a value, one panel per (title, x, y, value), stacked."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(len(panels), 1, figsize=(size[0], size[1] * len(panels)), squeeze=False)
+    for ax, (title, x, y, c) in zip(axes[:, 0], panels):
+        sc = ax.scatter(x, y, c=c, s=marker, cmap="jet")
+        fig.colorbar(sc, ax=ax, label=label)
+        ax.set_aspect("equal")
+        ax.set_title(title, fontsize=9)
+    fig.tight_layout()
+    fig.savefig(png_path, dpi=110)
+    plt.close(fig)
+    return png_path

@@ -1,0 +1,203 @@
+"""Colliding rubber rings (Gray, Monaghan & Swift 2001; Adepu & Ramachandran 2021, section 4.6).
+
+Two equal rings, inner radius 0.03 m, outer 0.04 m, centres at x = -/+0.041 m (2 mm gap),
+E = 10 MPa, rho0 = 1200 kg/m^3, Poisson ratio ``--poisson`` (paper: 0.3975 and 0.47),
+each moving toward the other at ``--v0`` c0 (0.059: the "0.12 c0" of the paper read as
+the approach speed, as Gray et al. run it), Monaghan artificial viscosity alpha = 1,
+h = dx (paper: dx = 1 mm), end time 0.016 s.  ``--scheme`` ctvf (default; ``--shifting``
+spst or ipst) or gtvf.  Particles on the square lattice through each ring's centre,
+r_in <= r < r_out (``--lattice vertex``; this is the lattice of PySPH's
+``solid_mech.rings`` example, so ``--dx 0.0005`` gives 17 584 particles against that example's 17 592: its float grid
+keeps 8 of the points that lie exactly on the outer circles by round-off, the integer
+test here none) or on the
+cell-centred lattice (``--lattice centred``, :func:`sphgen.geometry.annulus`).
+
+``results.json``: whether the run reached the end, the largest speed over the run (a
+blow-up shows as a speed of order c0), the energies (kinetic, elastic: s':s'/(4G) +
+p^2/(2K) per unit volume) at the start and the end, the x velocity of each ring's centre
+of mass at the end (reversed: the rings bounced), and the trajectory of the material
+points A (outer left) and B (outer top) of the left ring.  Plots: energy.png,
+points.png (A and B against t), rings.png (the final state coloured by p).
+"""
+import math
+import os
+
+import numpy as np
+
+from sphgen import io
+from sphgen.app import Application
+from sphgen.errors import InputError
+from sphgen.geometry import annulus, vertex_lattice
+from sphgen.particles import ParticleArray
+from sphgen.tools.plots import particle_panels
+from sphgen.tools.probes import MaterialPoints
+
+from ..equations.shifting import SHIFTINGS
+from ..schemes.ctvf import SOLID_CORRECTIONS, CTVFSolidScheme, elastic_constants
+from ..schemes.gtvf import GTVFSolidScheme
+
+E, RHO0 = 1.0e7, 1200.0
+R_IN, R_OUT, CENTRE = 0.03, 0.04, 0.041
+SCHEMES = ("ctvf", "gtvf")
+LATTICES = ("vertex", "centred")
+
+
+def ring_lattice(cx, dx, lattice):
+    """One ring centred at (cx, 0) on the chosen lattice."""
+    if lattice == "centred":
+        return annulus(cx, 0.0, R_IN, R_OUT, dx)
+    x, y = vertex_lattice(dx, -R_OUT, R_OUT, -R_OUT, R_OUT)
+    r2 = (np.rint(x / dx) ** 2 + np.rint(y / dx) ** 2) * dx * dx     # exact on the circles
+    keep = (r2 >= R_IN ** 2 * (1 - 1e-9)) & (r2 < R_OUT ** 2 * (1 - 1e-9))
+    return x[keep] + cx, y[keep]
+
+
+def energies(pa, G, K):
+    """(kinetic, elastic): sum m |u|^2 / 2 and sum V (s':s' / (4G) + p^2 / (2K))."""
+    kinetic = 0.5 * float(np.sum(pa.m * (pa.u ** 2 + pa.v ** 2)))
+    s = pa.sd.reshape(-1, 9)
+    vol = pa.m / pa.rho
+    elastic = float(np.sum(vol * (np.sum(s * s, axis=1) / (4.0 * G) + pa.p ** 2 / (2.0 * K))))
+    return kinetic, elastic
+
+
+class Rings(Application):
+    """Two elastic rings colliding head on: CTVF (SPST or IPST) or GTVF."""
+
+    tf = 0.016
+    pfreq = 1000
+    dim = 2
+    history_columns = ("t", "kinetic", "elastic", "max_speed", "xA", "yA", "xB", "yB", "u_left", "u_right")
+    error_key = None
+
+    def add_user_options(self, group):
+        group.add_argument("--scheme", choices=SCHEMES, default="ctvf", help="CTVF or GTVF (default ctvf)")
+        group.add_argument("--shifting", choices=SHIFTINGS, default=None,
+                           help="homogenisation (default: spst for ctvf, gtvf for gtvf)")
+        group.add_argument("--no-corrections", action="store_true", help="ctvf: no correction terms")
+        group.add_argument("--poisson", type=float, default=0.3975, help="Poisson ratio (paper: 0.3975, 0.47)")
+        group.add_argument("--v0", type=float, default=0.059, help="speed of each ring / c0 (default %(default)s)")
+        group.add_argument("--dx", type=float, default=0.001, help="particle spacing (paper: 0.001 m)")
+        group.add_argument("--hdx", type=float, default=1.0, help="h / dx (default %(default)s)")
+        group.add_argument("--lattice", choices=LATTICES, default="vertex",
+                           help="vertex: points centre + i dx (PySPH's rings); centred: cell centres")
+        group.add_argument("--alpha", type=float, default=1.0, help="artificial viscosity (paper: 1)")
+        group.add_argument("--record-every", type=float, default=1e-4, help="time between samples (s)")
+
+    def consume_user_options(self, o):
+        for name in ("dx", "hdx", "v0", "record_every"):
+            v = getattr(o, name)
+            if not (math.isfinite(v) and v > 0):
+                raise InputError(f"--{name.replace('_', '-')} must be a positive number, got {v}")
+        if not 0 < o.poisson < 0.5:
+            raise InputError(f"--poisson must be in (0, 0.5), got {o.poisson}")
+        if o.dx > 0.005:
+            raise InputError(f"--dx {o.dx} leaves fewer than 2 particles across the rings")
+        if o.no_corrections and o.scheme != "ctvf":
+            raise InputError("--no-corrections applies to --scheme ctvf only")
+        self.c0, self.G = elastic_constants(E, o.poisson, RHO0)
+        self.K = RHO0 * self.c0 ** 2
+        self.shifting = o.shifting or ("spst" if o.scheme == "ctvf" else "gtvf")
+        self._next_record = 0.0
+
+    def create_particles(self):
+        o, dx = self.options, self.options.dx
+        xl, yl = ring_lattice(-CENTRE, dx, o.lattice)
+        xr, yr = ring_lattice(CENTRE, dx, o.lattice)
+        x, y = np.concatenate([xl, xr]), np.concatenate([yl, yr])
+        n = x.size
+        u = np.where(x < 0, 1.0, -1.0) * o.v0 * self.c0
+        pa = ParticleArray("rings", x=x, y=y, u=u, rho=np.full(n, RHO0), m=np.full(n, RHO0 * dx * dx),
+                           h=np.full(n, o.hdx * dx))
+        self.left = np.flatnonzero(x < 0)
+        near = [int(np.argmin((x - px) ** 2 + (y - py) ** 2)) for px, py in ((-CENTRE - R_OUT, 0.0), (-CENTRE, R_OUT))]
+        self.points = MaterialPoints("rings", gids=near)          # A (outer left), B (outer top)
+        return [pa]
+
+    def create_scheme(self):
+        o = self.options
+        common = dict(h=o.hdx * o.dx, dx=o.dx, umax=o.v0 * self.c0, shifting=self.shifting, alpha=o.alpha)
+        if o.scheme == "gtvf":
+            return GTVFSolidScheme(["rings"], 2, RHO0, E, o.poisson, **common)
+        corrections = () if o.no_corrections else SOLID_CORRECTIONS
+        return CTVFSolidScheme(["rings"], 2, RHO0, E, o.poisson, corrections=corrections, **common)
+
+    def history_meta(self):
+        o = self.options
+        return {"dx": o.dx, "scheme": o.scheme, "shifting": self.shifting, "poisson": o.poisson, "v0": o.v0,
+                "c0": self.c0, "G": self.G, "K": self.K, "n_particles": int(self.scene.by_name["rings"].n),
+                "lattice": o.lattice, "corrections": not o.no_corrections}
+
+    def row(self, pa, t):
+        kinetic, elastic = energies(pa, self.G, self.K)
+        (xa, ya), (xb, yb) = self.points.positions({"rings": pa})
+        left = np.isin(pa.gid, self.left)
+        ul = float(np.sum(pa.m[left] * pa.u[left]) / np.sum(pa.m[left]))
+        ur = float(np.sum(pa.m[~left] * pa.u[~left]) / np.sum(pa.m[~left]))
+        return [t, kinetic, elastic, float(np.sqrt((pa.u ** 2 + pa.v ** 2).max())), float(xa), float(ya),
+                float(xb), float(yb), ul, ur]
+
+    def post_step(self, solver):
+        pa = self.scene.by_name["rings"]
+        if not self.history:
+            self.history.append(self.row(pa, 0.0))
+        if solver.t >= self._next_record - 0.5 * solver.dt or solver.t >= solver.tf - 0.5 * solver.dt:
+            self.history.append(self.row(pa, solver.t))
+            self._next_record = solver.t + self.options.record_every
+
+    def post_process(self, outdir):
+        hist, rows = io.read_history(outdir)
+        t, ek, ee, vmax = rows[:, 0], rows[:, 1], rows[:, 2], rows[:, 3]
+        total = ek + ee
+        results = {
+            "t": float(t[-1]), "reached_end": bool(t[-1] >= self.options.tf * (1 - 1e-6)),
+            "scheme": hist["scheme"], "shifting": hist["shifting"], "poisson": hist["poisson"],
+            "n_particles": hist["n_particles"], "dx": hist["dx"],
+            "max_speed_over_c0": float(vmax.max() / hist["c0"]),
+            "energy_initial": float(total[0]), "energy_final": float(total[-1]),
+            "energy_final_over_initial": float(total[-1] / total[0]),
+            "kinetic_min_over_initial": float(ek.min() / ek[0]),
+            "elastic_max_over_initial": float(ee.max() / total[0]),
+            "u_left_final": float(rows[-1, 8]), "u_right_final": float(rows[-1, 9]),
+            "bounced": bool(rows[-1, 8] < 0 < rows[-1, 9]),
+            "point_A": rows[:, 4:6].tolist()[-1], "point_B": rows[:, 6:8].tolist()[-1],
+        }
+        io.write_json(os.path.join(outdir, "results.json"), results)
+        self.plot(outdir, rows, hist)
+        print(f"rings: {hist['scheme']}+{hist['shifting']} nu={hist['poisson']} n={hist['n_particles']} t={t[-1]:.4g}  "
+              f"E_end/E_0 {results['energy_final_over_initial']:.3f}  max|u|/c0 {results['max_speed_over_c0']:.3f}  "
+              f"u_cm left/right {results['u_left_final']:.3g}/{results['u_right_final']:.3g}\n"
+              f"results: {os.path.join(outdir, 'results.json')}")
+        return results
+
+    def plot(self, outdir, rows, hist):
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        t = rows[:, 0] * 1e3
+        e0 = rows[0, 1] + rows[0, 2]
+        fig, ax = plt.subplots(figsize=(6, 4))
+        for k, name in ((1, "kinetic"), (2, "elastic")):
+            ax.plot(t, rows[:, k] / e0, label=name)
+        ax.plot(t, (rows[:, 1] + rows[:, 2]) / e0, "k-", label="total")
+        ax.set_xlabel("t [ms]")
+        ax.set_ylabel("E / E(0)")
+        ax.set_title(f"{hist['scheme'].upper()} + {hist['shifting'].upper()}, nu = {hist['poisson']}", fontsize=9)
+        ax.legend()
+        fig.tight_layout()
+        fig.savefig(os.path.join(outdir, "energy.png"), dpi=100)
+        plt.close(fig)
+        fig, ax = plt.subplots(figsize=(6, 4))
+        for c, lab in ((4, "x_A"), (5, "y_A"), (6, "x_B"), (7, "y_B")):
+            ax.plot(t, rows[:, c], label=lab)
+        ax.set_xlabel("t [ms]")
+        ax.set_ylabel("position [m]")
+        ax.set_title("points A (outer left) and B (outer top) of the left ring", fontsize=9)
+        ax.legend()
+        fig.tight_layout()
+        fig.savefig(os.path.join(outdir, "points.png"), dpi=100)
+        plt.close(fig)
+        if self.scene is not None:
+            pa = self.scene.by_name["rings"]
+            particle_panels(os.path.join(outdir, "rings.png"),
+                            [(f"t = {rows[-1, 0] * 1e3:.3g} ms", pa.x, pa.y, pa.p)], size=(8.0, 4.0), marker=1)
