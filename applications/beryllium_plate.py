@@ -31,6 +31,7 @@ from sphgen.particles import ParticleArray
 from sphgen.tools.probes import pairs_within
 
 from ..schemes.shtc import SHTCScheme
+from ._perturbation import add_perturbation_options, check_perturbation, perturbed
 
 L, W = 0.06, 0.01
 RHO0, C0 = 1850.0, 9046.59
@@ -154,6 +155,7 @@ class BerylliumPlate(Application):
         group.add_argument("--rho0", type=float, default=RHO0, help="density (thesis: 1850 kg/m^3)")
         group.add_argument("--samples-per-period", type=int, default=400,
                            help="history samples per linear period 2 pi/omega (default %(default)s)")
+        add_perturbation_options(group)
 
     def consume_user_options(self, o):
         if o.nw < 4:
@@ -164,16 +166,19 @@ class BerylliumPlate(Application):
             raise InputError(f"--rho0 must be positive, got {o.rho0}")
         if o.samples_per_period < 10:
             raise InputError(f"--samples-per-period must be at least 10, got {o.samples_per_period}")
+        check_perturbation(o)
         self.dr = W / o.nw
         self.rho0 = o.rho0
 
     def create_particles(self):
         x, y = isometric_lattice(self.dr, L, W)
+        self.centre_gid = int(np.argmin(x * x + y * y))
+        x, y = perturbed((x, y), self.dr, self.options)
         n = x.size
-        plate = ParticleArray("plate", x=x, y=y, u=np.zeros(n), v=bending_velocity(x),
+        self._v0 = bending_velocity(x)
+        plate = ParticleArray("plate", x=x, y=y, u=np.zeros(n), v=self._v0.copy(),
                               m=np.full(n, self.rho0 * self.dr ** 2), h=np.full(n, HDR * self.dr),
                               rho=np.full(n, self.rho0))
-        self.centre_gid = int(np.argmin(x * x + y * y))
         return [plate]
 
     def create_scheme(self):
@@ -190,7 +195,7 @@ class BerylliumPlate(Application):
     def record(self, t, first=False):
         pa = self.scene.by_name["plate"]
         if first:   # the state before the first step (energies of the initial condition)
-            e = {"kinetic": 0.5 * float(np.sum(pa.m * bending_velocity(self._x0) ** 2)),
+            e = {"kinetic": 0.5 * float(np.sum(pa.m * self._v0[pa.gid] ** 2)),
                  "bulk": 0.0, "shear": 0.0, "penalty": 0.0}
             e["total"] = e["kinetic"]
             self.history.append([0.0, 0.0] + [e[k] for k in self.history_columns[2:]])
@@ -199,15 +204,10 @@ class BerylliumPlate(Application):
         k = int(np.flatnonzero(pa.gid == self.centre_gid)[0])
         self.history.append([t, float(pa.y[k])] + [e[c] for c in self.history_columns[2:]])
 
-    @property
-    def _x0(self):
-        pa = self.scene.by_name["plate"]
-        x, _ = isometric_lattice(self.dr, L, W)
-        return x[pa.gid]
-
     def history_meta(self):
         o = self.options
-        return {"nw": o.nw, "cp_factor": o.cp_factor, "rho0": self.rho0, "dr": self.dr}
+        return {"nw": o.nw, "cp_factor": o.cp_factor, "rho0": self.rho0, "dr": self.dr,
+                "perturb": o.perturb, "seed": o.seed}
 
     def post_process(self, outdir):
         """results.json, centre.png, energy.png and pressure.png from the run's files."""
@@ -227,6 +227,8 @@ class BerylliumPlate(Application):
         results = {
             "t": float(t[-1]), "nw": hist["nw"], "cp_factor": hist["cp_factor"], "dr": dr,
             "energy_drift": float(drift.max()), "energy_drift_final": float(drift[-1]),
+            "energy_error": float(drift.max()),
+            "max_density_error": float(np.abs(np.asarray(state["rho"]) / hist["rho0"] - 1.0).max()),
             "energy_initial": float(et[0]),
             "penalty_energy_max": float((ep / et[0]).max()),
             "period": period, "period_from": how,

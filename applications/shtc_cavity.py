@@ -24,10 +24,11 @@ from sphgen.app import Application
 from sphgen.errors import InputError
 from sphgen.geometry import hexagonal_lattice, layers_for_support, wall_layers_box
 from sphgen.particles import ParticleArray
-from sphgen.tools.probes import shepard
+from sphgen.tools.probes import _prop as get, shepard
 from sphgen.tools.reference import GHIA_RE, ghia_1982
 
 from ..schemes.shtc import SHTCScheme
+from ._perturbation import add_perturbation_options, check_perturbation, perturbed
 
 RHO0, C0, CS, ULID, T_RAMP = 1.0, 20.0, 20.0, 1.0, 0.4
 HDR = 1.5
@@ -38,6 +39,11 @@ def lid_motion(t_ramp=T_RAMP, speed=ULID):
     def motion(t, pa):
         return {"u": speed * min(t / t_ramp, 1.0)}
     return motion
+
+
+def all_columns(arrays):
+    """Positions, h, m, rho and velocities of fluid and walls together (for Shepard probes)."""
+    return {k: np.concatenate([get(pa, k) for pa in arrays.values()]) for k in ("x", "y", "h", "m", "rho", "u", "v")}
 
 
 class SHTCCavity(Application):
@@ -53,12 +59,14 @@ class SHTCCavity(Application):
         group.add_argument("--nx", type=int, default=200, help="particles per side: dr = 1/nx (paper: 200 at Re 100)")
         group.add_argument("--re", type=int, default=100, choices=GHIA_RE, help="Reynolds number (default %(default)s)")
         group.add_argument("--cs", type=float, default=CS, help="shear sound speed (paper: 20)")
+        add_perturbation_options(group)
 
     def consume_user_options(self, o):
         if o.nx < 8:
             raise InputError(f"--nx must be at least 8, got {o.nx}")
         if not (math.isfinite(o.cs) and o.cs > 0):
             raise InputError(f"--cs must be positive, got {o.cs}")
+        check_perturbation(o)
         self.dr = 1.0 / o.nx
         self.nu = ULID / o.re
         self.tau = 6.0 * self.nu / o.cs ** 2
@@ -66,7 +74,7 @@ class SHTCCavity(Application):
 
     def create_particles(self):
         dr, h = self.dr, HDR * self.dr
-        x, y = hexagonal_lattice((4.0 / 3.0) ** 0.25 * dr, 0.0, 1.0, 0.0, 1.0)
+        x, y = perturbed(hexagonal_lattice((4.0 / 3.0) ** 0.25 * dr, 0.0, 1.0, 0.0, 1.0), dr, self.options)
         xw, yw, _, _ = wall_layers_box(0.0, 1.0, 0.0, 1.0, dr, layers_for_support(2.0, HDR), open_top=False)
         top = yw > 1.0
 
@@ -92,9 +100,7 @@ class SHTCCavity(Application):
     def centrelines(self, arrays, kernel):
         """(u at Ghia's y on x = 0.5, v at Ghia's x on y = 0.5, largest deviation from Ghia
         over the points more than 2 dr from the lid)."""
-        def get(pa, k):
-            return np.asarray(pa[k] if isinstance(pa, dict) else pa.get(k))
-        cols = {k: np.concatenate([get(pa, k) for pa in arrays.values()]) for k in ("x", "y", "h", "m", "rho", "u", "v")}
+        cols = all_columns(arrays)
         g = self.ghia
         part = (cols["x"], cols["y"], cols["h"], cols["m"], cols["rho"])
         u = shepard((np.full(g["y"].size, 0.5), g["y"]), *part, cols["u"], kernel)
@@ -121,6 +127,9 @@ class SHTCCavity(Application):
         results = {"t": float(t), "re": self.options.re, "nx": self.options.nx, "dr": self.dr, "tau": self.tau,
                    "dt_over_tau": float(self.solver.dt / self.tau) if self.solver is not None else None,
                    "ghia_error": err, "u_centre": u.tolist(), "v_centre": v.tolist(),
+                   "max_density_error": float(np.abs(np.asarray(get(arrays["fluid"], "rho")) / RHO0 - 1.0).max()),
+                   "kinetic_energy": float(0.5 * np.sum(get(arrays["fluid"], "m") * (get(arrays["fluid"], "u") ** 2
+                                                                                     + get(arrays["fluid"], "v") ** 2))),
                    "ghia_y": g["y"].tolist(), "ghia_u": g["u"].tolist(),
                    "ghia_x": g["x"].tolist(), "ghia_v": g["v"].tolist()}
         io.write_json(os.path.join(outdir, "results.json"), results)
@@ -135,9 +144,7 @@ class SHTCCavity(Application):
         import matplotlib.pyplot as plt
         g = self.ghia
 
-        def get(pa, k):
-            return np.asarray(pa[k] if isinstance(pa, dict) else pa.get(k))
-        cols = {k: np.concatenate([get(pa, k) for pa in arrays.values()]) for k in ("x", "y", "h", "m", "rho", "u", "v")}
+        cols = all_columns(arrays)
         part = (cols["x"], cols["y"], cols["h"], cols["m"], cols["rho"])
         s = np.linspace(0.0, 1.0, 101)
         u = shepard((np.full(s.size, 0.5), s), *part, cols["u"], kernel)
