@@ -11,7 +11,9 @@ t = 0.4 (the ramp is not stated in the papers; the authors' code ramps linearly 
 
 ``results.json``: u on x = 0.5 and v on y = 0.5 at Ghia's points (Shepard interpolation
 over fluid and walls) at the final time, and the largest deviation from Ghia's values
-over the points more than 2 dr from the lid (``ghia_error``).  Plots: centrelines.png,
+over the points more than 2 dr from the lid (``ghia_error``); ``viscosity_factor``: the
+effective viscosity of the step over nu (steady shear, linearised: 0.73 at the paper's dt/tau
+= 0.1, 1 at dt/tau = 1/3; see SHTCScheme's viscosity_factor).  Plots: centrelines.png,
 speed.png (the velocity field), Axy.png (the distortion field).
 """
 import math
@@ -27,7 +29,7 @@ from sphgen.particles import ParticleArray
 from sphgen.tools.probes import _prop as get, shepard
 from sphgen.tools.reference import GHIA_RE, ghia_1982
 
-from ..schemes.shtc import SHTCScheme
+from ..schemes.shtc import SHTCScheme, viscosity_factor
 from ._perturbation import add_perturbation_options, check_perturbation, perturbed
 
 RHO0, C0, CS, ULID, T_RAMP = 1.0, 20.0, 20.0, 1.0, 0.4
@@ -126,6 +128,8 @@ class SHTCCavity(Application):
         g = self.ghia
         results = {"t": float(t), "re": self.options.re, "nx": self.options.nx, "dr": self.dr, "tau": self.tau,
                    "dt_over_tau": float(self.solver.dt / self.tau) if self.solver is not None else None,
+                   "viscosity_factor": (viscosity_factor(self.solver.dt / self.tau)
+                                        if self.solver is not None else None),
                    "ghia_error": err, "u_centre": u.tolist(), "v_centre": v.tolist(),
                    "max_density_error": float(np.abs(np.asarray(get(arrays["fluid"], "rho")) / RHO0 - 1.0).max()),
                    "kinetic_energy": float(0.5 * np.sum(get(arrays["fluid"], "m") * (get(arrays["fluid"], "u") ** 2

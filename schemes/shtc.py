@@ -47,6 +47,23 @@ RK4_REAL_STABILITY = 2.785293563405282
 RELAXATION_DT_LIMIT = RK4_REAL_STABILITY / 6.0
 """dt/tau bound of the explicit RK4 relaxation: the stiffest rate at A = I is 6/tau (0.4642)."""
 
+def rk4_factor(z):
+    """Classical RK4's amplification 1 + z + z^2/2 + z^3/6 + z^4/24 of dy/dt = (z/dt) y."""
+    return 1.0 + z + z * z / 2.0 + z ** 3 / 6.0 + z ** 4 / 24.0
+
+
+def viscosity_factor(dt_over_tau):
+    """nu_effective / nu of the step in steady simple shear, linearised about A = I.
+
+    Each step shears A by dt L (Cayley) and then relaxes it by the RK4 factor R = R(-6 dt/tau);
+    the stress is read after the relaxation, so the steady strain is R dt L/(1 - R) instead of
+    tau L/6: nu_eff/nu = 6 (dt/tau) R/(1 - R).  0.86 at dt/tau = 0.05, 0.73 at 0.1 (the
+    paper's cavity), 1 at 1/3, 3.0 at 0.4 (derived here, not in the papers; docs/shtc.md).
+    """
+    r = rk4_factor(-6.0 * dt_over_tau)
+    return 6.0 * dt_over_tau * r / (1.0 - r)
+
+
 THETA_DETPOW = 5.0 / 3.0
 """theta = tau cs^2/3 |det A|^(-5/3) (paper footnote 1; thesis eq. 2.11)."""
 
