@@ -31,6 +31,7 @@ from sphgen.particles import ParticleArray
 from sphgen.tools.probes import pairs_within
 
 from ..schemes.shtc import SHTCScheme
+from ._solid_plots import plot_energy, plot_track
 from ._perturbation import add_perturbation_options, check_perturbation, perturbed
 
 L, W = 0.06, 0.01
@@ -254,29 +255,10 @@ class BerylliumPlate(Application):
         import matplotlib
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
-        fig, ax = plt.subplots(figsize=(6, 4))
-        ax.plot(t, yc, "r-", label="SHTC-SPH")
-        ax.plot(t, AMP * 70.076 * np.sin(OMEGA * t), "k--", lw=0.8, label="linear theory $A\\phi(0)\\sin\\omega t$")
-        ax.set_xlabel("t [s]")
-        ax.set_ylabel("$y$ of the centre [m]")
-        ax.set_title("(the finite-volume curve of Boscheri et al. 2022 is not available)", fontsize=8)
-        ax.legend()
-        fig.tight_layout()
-        fig.savefig(os.path.join(outdir, "centre.png"), dpi=100)
-        plt.close(fig)
-        fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4))
-        e0 = energies[0, -1]
-        for k, name in enumerate(("kinetic", "bulk", "shear", "penalty", "total")):
-            a.plot(t, energies[:, k] / e0, label=name)
-        a.set_xlabel("t [s]")
-        a.set_ylabel("E / E_total(0)")
-        a.legend()
-        b.plot(t, energies[:, -1] / e0 - 1.0)
-        b.set_xlabel("t [s]")
-        b.set_ylabel("E_total / E_total(0) - 1")
-        fig.tight_layout()
-        fig.savefig(os.path.join(outdir, "energy.png"), dpi=100)
-        plt.close(fig)
+        plot_track(os.path.join(outdir, "centre.png"), plt, t, yc, "$y$ of the centre [m]",
+                   "(the finite-volume curve of Boscheri et al. 2022 is not available)",
+                   (AMP * 70.076 * np.sin(OMEGA * t), "linear theory $A\\phi(0)\\sin\\omega t$"))
+        plot_energy(outdir, plt, t, energies)
         fig, ax = plt.subplots(figsize=(10, 2.6))
         sc = ax.scatter(state["x"], state["y"], c=state["p"], s=2, cmap="coolwarm")
         fig.colorbar(sc, ax=ax, label="p [Pa]")

@@ -33,6 +33,7 @@ from sphgen.particles import ParticleArray
 from sphgen.tools.probes import _prop
 
 from ..schemes.shtc import SHTCScheme
+from ._solid_plots import plot_energy, plot_track
 from ._perturbation import add_perturbation_options, check_perturbation, perturbed
 
 W, H = 1.0, 6.0
@@ -186,28 +187,9 @@ class TwistingColumn(Application):
         import matplotlib
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
-        fig, ax = plt.subplots(figsize=(6, 4))
-        ax.plot(t, zt, "r-", label="SHTC-SPH")
-        ax.set_xlabel("t [s]")
-        ax.set_ylabel("z / H of the top point")
-        ax.set_title("(the finite-element curve of the paper is not available)", fontsize=8)
-        ax.legend()
-        fig.tight_layout()
-        fig.savefig(os.path.join(outdir, "ztop.png"), dpi=100)
-        plt.close(fig)
-        fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4))
-        e0 = energies[0, -1]
-        for k, name in enumerate(("kinetic", "bulk", "shear", "penalty", "total")):
-            a.plot(t, energies[:, k] / e0, label=name)
-        a.set_xlabel("t [s]")
-        a.set_ylabel("E / E_total(0)")
-        a.legend()
-        b.plot(t, energies[:, -1] / e0 - 1.0)
-        b.set_xlabel("t [s]")
-        b.set_ylabel("E_total / E_total(0) - 1")
-        fig.tight_layout()
-        fig.savefig(os.path.join(outdir, "energy.png"), dpi=100)
-        plt.close(fig)
+        plot_track(os.path.join(outdir, "ztop.png"), plt, t, zt, "z / H of the top point",
+                   "(the finite-element curve of the paper is not available)")
+        plot_energy(outdir, plt, t, energies)
         snaps = self._snapshots(outdir)
         fig, axes = plt.subplots(1, len(snaps), figsize=(2.2 * len(snaps) + 1, 6), squeeze=False)
         for ax, (ts, s) in zip(axes[0], snaps):
