@@ -1,7 +1,8 @@
 """Lid-driven cavity with SHTC-SPH in its fluid regime (Kincl, Peshkov, Pavelka & Klika (2023),
 section 4.4; Kincl's thesis (2023), section 2.7), against Ghia, Ghia & Shin (1982).
 
-Fluid in (0, 1)^2 on the isometric lattice (dr = 1/``--nx``; paper: 1/200 at Re = 100),
+Fluid in (0, 1)^2 on the isometric lattice fitted to the box (``filling_lattice``; dr =
+1/``--nx``; paper: 1/200 at Re = 100),
 DPRZ with rho0 = 1, c0 = cs = 20, nu = 1/Re, tau = 6 nu/cs^2 (eq. 29), c_p = 0.  Left,
 right and bottom walls: ceil(2h/dr) = 3 layers of dummy particles at rest that carry their
 own state and run the scheme's equations; the lid is the same kind of layer above y = 1,
@@ -24,7 +25,7 @@ import numpy as np
 from sphgen import io
 from sphgen.app import Application
 from sphgen.errors import InputError
-from sphgen.geometry import hexagonal_lattice, layers_for_support, wall_layers_box
+from sphgen.geometry import layers_for_support, wall_layers_box
 from sphgen.particles import ParticleArray
 from sphgen.tools.probes import _prop as get, shepard
 from sphgen.tools.reference import GHIA_RE, ghia_1982
@@ -46,6 +47,19 @@ def lid_motion(t_ramp=T_RAMP, speed=ULID):
 def all_columns(arrays):
     """Positions, h, m, rho and velocities of fluid and walls together (for Shepard probes)."""
     return {k: np.concatenate([get(pa, k) for pa in arrays.values()]) for k in ("x", "y", "h", "m", "rho", "u", "v")}
+
+
+def filling_lattice(dr, side=1.0):
+    """Isometric lattice that fills (0, side)^2 with whole rows and columns: the paper's spacing
+    (4/3)^(1/4) dr and rows (3/4)^(1/4) dr rounded so that round(side/spacing) points and rows
+    fit exactly; rows at (j + 1/2) b, points at (i + 1/4) a or (i + 3/4) a in alternate rows.
+    So the fluid stands half a row from the lid and the floor at every resolution (the plain
+    ``hexagonal_lattice`` of the box left 1.38 dr under the lid at dr = 1/40)."""
+    nr = max(int(round(side / (0.75 ** 0.25 * dr))), 1)
+    nc = max(int(round(side / ((4.0 / 3.0) ** 0.25 * dr))), 1)
+    b, a = side / nr, side / nc
+    j, i = np.meshgrid(np.arange(nr), np.arange(nc), indexing="ij")
+    return ((i + 0.25 + 0.5 * (j % 2)) * a).ravel(), ((j + 0.5) * b).ravel()
 
 
 class SHTCCavity(Application):
@@ -76,7 +90,7 @@ class SHTCCavity(Application):
 
     def create_particles(self):
         dr, h = self.dr, HDR * self.dr
-        x, y = perturbed(hexagonal_lattice((4.0 / 3.0) ** 0.25 * dr, 0.0, 1.0, 0.0, 1.0), dr, self.options)
+        x, y = perturbed(filling_lattice(dr), dr, self.options)
         xw, yw, _, _ = wall_layers_box(0.0, 1.0, 0.0, 1.0, dr, layers_for_support(2.0, HDR), open_top=False)
         top = yw > 1.0
 
