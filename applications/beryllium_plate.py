@@ -31,6 +31,8 @@ from sphgen.particles import ParticleArray
 from sphgen.tools.probes import pairs_within
 
 from ..schemes.shtc import SHTCScheme
+from ._solid_plots import plot_energy, plot_track
+from ._perturbation import add_perturbation_options, check_perturbation, perturbed
 
 L, W = 0.06, 0.01
 RHO0, C0 = 1850.0, 9046.59
@@ -154,6 +156,7 @@ class BerylliumPlate(Application):
         group.add_argument("--rho0", type=float, default=RHO0, help="density (thesis: 1850 kg/m^3)")
         group.add_argument("--samples-per-period", type=int, default=400,
                            help="history samples per linear period 2 pi/omega (default %(default)s)")
+        add_perturbation_options(group)
 
     def consume_user_options(self, o):
         if o.nw < 4:
@@ -164,16 +167,19 @@ class BerylliumPlate(Application):
             raise InputError(f"--rho0 must be positive, got {o.rho0}")
         if o.samples_per_period < 10:
             raise InputError(f"--samples-per-period must be at least 10, got {o.samples_per_period}")
+        check_perturbation(o)
         self.dr = W / o.nw
         self.rho0 = o.rho0
 
     def create_particles(self):
         x, y = isometric_lattice(self.dr, L, W)
+        self.centre_gid = int(np.argmin(x * x + y * y))
+        x, y = perturbed((x, y), self.dr, self.options)
         n = x.size
-        plate = ParticleArray("plate", x=x, y=y, u=np.zeros(n), v=bending_velocity(x),
+        self._v0 = bending_velocity(x)
+        plate = ParticleArray("plate", x=x, y=y, u=np.zeros(n), v=self._v0.copy(),
                               m=np.full(n, self.rho0 * self.dr ** 2), h=np.full(n, HDR * self.dr),
                               rho=np.full(n, self.rho0))
-        self.centre_gid = int(np.argmin(x * x + y * y))
         return [plate]
 
     def create_scheme(self):
@@ -190,7 +196,7 @@ class BerylliumPlate(Application):
     def record(self, t, first=False):
         pa = self.scene.by_name["plate"]
         if first:   # the state before the first step (energies of the initial condition)
-            e = {"kinetic": 0.5 * float(np.sum(pa.m * bending_velocity(self._x0) ** 2)),
+            e = {"kinetic": 0.5 * float(np.sum(pa.m * self._v0[pa.gid] ** 2)),
                  "bulk": 0.0, "shear": 0.0, "penalty": 0.0}
             e["total"] = e["kinetic"]
             self.history.append([0.0, 0.0] + [e[k] for k in self.history_columns[2:]])
@@ -199,15 +205,10 @@ class BerylliumPlate(Application):
         k = int(np.flatnonzero(pa.gid == self.centre_gid)[0])
         self.history.append([t, float(pa.y[k])] + [e[c] for c in self.history_columns[2:]])
 
-    @property
-    def _x0(self):
-        pa = self.scene.by_name["plate"]
-        x, _ = isometric_lattice(self.dr, L, W)
-        return x[pa.gid]
-
     def history_meta(self):
         o = self.options
-        return {"nw": o.nw, "cp_factor": o.cp_factor, "rho0": self.rho0, "dr": self.dr}
+        return {"nw": o.nw, "cp_factor": o.cp_factor, "rho0": self.rho0, "dr": self.dr,
+                "perturb": o.perturb, "seed": o.seed}
 
     def post_process(self, outdir):
         """results.json, centre.png, energy.png and pressure.png from the run's files."""
@@ -227,6 +228,8 @@ class BerylliumPlate(Application):
         results = {
             "t": float(t[-1]), "nw": hist["nw"], "cp_factor": hist["cp_factor"], "dr": dr,
             "energy_drift": float(drift.max()), "energy_drift_final": float(drift[-1]),
+            "energy_error": float(drift.max()),
+            "max_density_error": float(np.abs(np.asarray(state["rho"]) / hist["rho0"] - 1.0).max()),
             "energy_initial": float(et[0]),
             "penalty_energy_max": float((ep / et[0]).max()),
             "period": period, "period_from": how,
@@ -252,29 +255,10 @@ class BerylliumPlate(Application):
         import matplotlib
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
-        fig, ax = plt.subplots(figsize=(6, 4))
-        ax.plot(t, yc, "r-", label="SHTC-SPH")
-        ax.plot(t, AMP * 70.076 * np.sin(OMEGA * t), "k--", lw=0.8, label="linear theory $A\\phi(0)\\sin\\omega t$")
-        ax.set_xlabel("t [s]")
-        ax.set_ylabel("$y$ of the centre [m]")
-        ax.set_title("(the finite-volume curve of Boscheri et al. 2022 is not available)", fontsize=8)
-        ax.legend()
-        fig.tight_layout()
-        fig.savefig(os.path.join(outdir, "centre.png"), dpi=100)
-        plt.close(fig)
-        fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4))
-        e0 = energies[0, -1]
-        for k, name in enumerate(("kinetic", "bulk", "shear", "penalty", "total")):
-            a.plot(t, energies[:, k] / e0, label=name)
-        a.set_xlabel("t [s]")
-        a.set_ylabel("E / E_total(0)")
-        a.legend()
-        b.plot(t, energies[:, -1] / e0 - 1.0)
-        b.set_xlabel("t [s]")
-        b.set_ylabel("E_total / E_total(0) - 1")
-        fig.tight_layout()
-        fig.savefig(os.path.join(outdir, "energy.png"), dpi=100)
-        plt.close(fig)
+        plot_track(os.path.join(outdir, "centre.png"), plt, t, yc, "$y$ of the centre [m]",
+                   "(the finite-volume curve of Boscheri et al. 2022 is not available)",
+                   (AMP * 70.076 * np.sin(OMEGA * t), "linear theory $A\\phi(0)\\sin\\omega t$"))
+        plot_energy(outdir, plt, t, energies)
         fig, ax = plt.subplots(figsize=(10, 2.6))
         sc = ax.scatter(state["x"], state["y"], c=state["p"], s=2, cmap="coolwarm")
         fig.colorbar(sc, ax=ax, label="p [Pa]")

@@ -1,7 +1,8 @@
 """Lid-driven cavity with SHTC-SPH in its fluid regime (Kincl, Peshkov, Pavelka & Klika (2023),
 section 4.4; Kincl's thesis (2023), section 2.7), against Ghia, Ghia & Shin (1982).
 
-Fluid in (0, 1)^2 on the isometric lattice (dr = 1/``--nx``; paper: 1/200 at Re = 100),
+Fluid in (0, 1)^2 on the isometric lattice fitted to the box (``filling_lattice``; dr =
+1/``--nx``; paper: 1/200 at Re = 100),
 DPRZ with rho0 = 1, c0 = cs = 20, nu = 1/Re, tau = 6 nu/cs^2 (eq. 29), c_p = 0.  Left,
 right and bottom walls: ceil(2h/dr) = 3 layers of dummy particles at rest that carry their
 own state and run the scheme's equations; the lid is the same kind of layer above y = 1,
@@ -11,7 +12,9 @@ t = 0.4 (the ramp is not stated in the papers; the authors' code ramps linearly 
 
 ``results.json``: u on x = 0.5 and v on y = 0.5 at Ghia's points (Shepard interpolation
 over fluid and walls) at the final time, and the largest deviation from Ghia's values
-over the points more than 2 dr from the lid (``ghia_error``).  Plots: centrelines.png,
+over the points more than 2 dr from the lid (``ghia_error``); ``viscosity_factor``: the
+effective viscosity of the step over nu (steady shear, linearised: 0.73 at the paper's dt/tau
+= 0.1, 1 at dt/tau = 1/3; see SHTCScheme's viscosity_factor).  Plots: centrelines.png,
 speed.png (the velocity field), Axy.png (the distortion field).
 """
 import math
@@ -22,12 +25,13 @@ import numpy as np
 from sphgen import io
 from sphgen.app import Application
 from sphgen.errors import InputError
-from sphgen.geometry import hexagonal_lattice, layers_for_support, wall_layers_box
+from sphgen.geometry import layers_for_support, wall_layers_box
 from sphgen.particles import ParticleArray
-from sphgen.tools.probes import shepard
+from sphgen.tools.probes import _prop as get, shepard
 from sphgen.tools.reference import GHIA_RE, ghia_1982
 
-from ..schemes.shtc import SHTCScheme
+from ..schemes.shtc import SHTCScheme, viscosity_factor
+from ._perturbation import add_perturbation_options, check_perturbation, perturbed
 
 RHO0, C0, CS, ULID, T_RAMP = 1.0, 20.0, 20.0, 1.0, 0.4
 HDR = 1.5
@@ -38,6 +42,24 @@ def lid_motion(t_ramp=T_RAMP, speed=ULID):
     def motion(t, pa):
         return {"u": speed * min(t / t_ramp, 1.0)}
     return motion
+
+
+def all_columns(arrays):
+    """Positions, h, m, rho and velocities of fluid and walls together (for Shepard probes)."""
+    return {k: np.concatenate([get(pa, k) for pa in arrays.values()]) for k in ("x", "y", "h", "m", "rho", "u", "v")}
+
+
+def filling_lattice(dr, side=1.0):
+    """Isometric lattice that fills (0, side)^2 with whole rows and columns: the paper's spacing
+    (4/3)^(1/4) dr and rows (3/4)^(1/4) dr rounded so that round(side/spacing) points and rows
+    fit exactly; rows at (j + 1/2) b, points at (i + 1/4) a or (i + 3/4) a in alternate rows.
+    So the fluid stands half a row from the lid and the floor at every resolution (the plain
+    ``hexagonal_lattice`` of the box left 1.38 dr under the lid at dr = 1/40)."""
+    nr = max(int(round(side / (0.75 ** 0.25 * dr))), 1)
+    nc = max(int(round(side / ((4.0 / 3.0) ** 0.25 * dr))), 1)
+    b, a = side / nr, side / nc
+    j, i = np.meshgrid(np.arange(nr), np.arange(nc), indexing="ij")
+    return ((i + 0.25 + 0.5 * (j % 2)) * a).ravel(), ((j + 0.5) * b).ravel()
 
 
 class SHTCCavity(Application):
@@ -53,12 +75,14 @@ class SHTCCavity(Application):
         group.add_argument("--nx", type=int, default=200, help="particles per side: dr = 1/nx (paper: 200 at Re 100)")
         group.add_argument("--re", type=int, default=100, choices=GHIA_RE, help="Reynolds number (default %(default)s)")
         group.add_argument("--cs", type=float, default=CS, help="shear sound speed (paper: 20)")
+        add_perturbation_options(group)
 
     def consume_user_options(self, o):
         if o.nx < 8:
             raise InputError(f"--nx must be at least 8, got {o.nx}")
         if not (math.isfinite(o.cs) and o.cs > 0):
             raise InputError(f"--cs must be positive, got {o.cs}")
+        check_perturbation(o)
         self.dr = 1.0 / o.nx
         self.nu = ULID / o.re
         self.tau = 6.0 * self.nu / o.cs ** 2
@@ -66,7 +90,7 @@ class SHTCCavity(Application):
 
     def create_particles(self):
         dr, h = self.dr, HDR * self.dr
-        x, y = hexagonal_lattice((4.0 / 3.0) ** 0.25 * dr, 0.0, 1.0, 0.0, 1.0)
+        x, y = perturbed(filling_lattice(dr), dr, self.options)
         xw, yw, _, _ = wall_layers_box(0.0, 1.0, 0.0, 1.0, dr, layers_for_support(2.0, HDR), open_top=False)
         top = yw > 1.0
 
@@ -92,9 +116,7 @@ class SHTCCavity(Application):
     def centrelines(self, arrays, kernel):
         """(u at Ghia's y on x = 0.5, v at Ghia's x on y = 0.5, largest deviation from Ghia
         over the points more than 2 dr from the lid)."""
-        def get(pa, k):
-            return np.asarray(pa[k] if isinstance(pa, dict) else pa.get(k))
-        cols = {k: np.concatenate([get(pa, k) for pa in arrays.values()]) for k in ("x", "y", "h", "m", "rho", "u", "v")}
+        cols = all_columns(arrays)
         g = self.ghia
         part = (cols["x"], cols["y"], cols["h"], cols["m"], cols["rho"])
         u = shepard((np.full(g["y"].size, 0.5), g["y"]), *part, cols["u"], kernel)
@@ -120,7 +142,12 @@ class SHTCCavity(Application):
         g = self.ghia
         results = {"t": float(t), "re": self.options.re, "nx": self.options.nx, "dr": self.dr, "tau": self.tau,
                    "dt_over_tau": float(self.solver.dt / self.tau) if self.solver is not None else None,
+                   "viscosity_factor": (viscosity_factor(self.solver.dt / self.tau)
+                                        if self.solver is not None else None),
                    "ghia_error": err, "u_centre": u.tolist(), "v_centre": v.tolist(),
+                   "max_density_error": float(np.abs(np.asarray(get(arrays["fluid"], "rho")) / RHO0 - 1.0).max()),
+                   "kinetic_energy": float(0.5 * np.sum(get(arrays["fluid"], "m") * (get(arrays["fluid"], "u") ** 2
+                                                                                     + get(arrays["fluid"], "v") ** 2))),
                    "ghia_y": g["y"].tolist(), "ghia_u": g["u"].tolist(),
                    "ghia_x": g["x"].tolist(), "ghia_v": g["v"].tolist()}
         io.write_json(os.path.join(outdir, "results.json"), results)
@@ -135,9 +162,7 @@ class SHTCCavity(Application):
         import matplotlib.pyplot as plt
         g = self.ghia
 
-        def get(pa, k):
-            return np.asarray(pa[k] if isinstance(pa, dict) else pa.get(k))
-        cols = {k: np.concatenate([get(pa, k) for pa in arrays.values()]) for k in ("x", "y", "h", "m", "rho", "u", "v")}
+        cols = all_columns(arrays)
         part = (cols["x"], cols["y"], cols["h"], cols["m"], cols["rho"])
         s = np.linspace(0.0, 1.0, 101)
         u = shepard((np.full(s.size, 0.5), s), *part, cols["u"], kernel)

@@ -2,7 +2,7 @@
 (2023), eq. 6) by the implicit mid-point rule, i.e. the Cayley transform of eq. 23."""
 from sphgen.equation import declare, helper
 
-from .shtc_stress import inverse3
+from sphgen.linalg import inv3, matmul3
 
 
 @helper
@@ -24,16 +24,6 @@ def cayley_update(a=[0.0], l=[0.0], dt=0.0, out=[0.0]):
     p[0] += 1.0
     p[4] += 1.0
     p[8] += 1.0
-    inverse3(p, pi)
-    for i in range(3):
-        for j in range(3):
-            s = 0.0
-            for k in range(3):
-                s += m[3 * i + k] * pi[3 * k + j]
-            p[3 * i + j] = s
-    for i in range(3):
-        for j in range(3):
-            s = 0.0
-            for k in range(3):
-                s += a[3 * i + k] * p[3 * k + j]
-            out[3 * i + j] = s
+    inv3(p, pi)
+    matmul3(m, pi, p)
+    matmul3(a, p, out)

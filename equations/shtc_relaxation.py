@@ -11,17 +11,17 @@ explicit RK4 step is stable for dt < 2.785 tau/6 = 0.464 tau (the scheme refuses
 from math import fabs, pow
 
 from sphgen.equation import declare, helper
+from sphgen.linalg import det3
 
-from .shtc_stress import inverse3, shear_force
+from .shtc_stress import shear_force
 
 
 @helper
 def relaxation_rate(a=[0.0], rate=0.0, model=0, detpow=0.0, out=[0.0]):
     """out = -rate |det A|^detpow eps_A/cs^2 (rate = 3/tau: Kincl et al. (2023), eq. 24c)."""
-    b = declare("matrix(9)")
     f = rate
     if detpow != 0.0:
-        f = rate * pow(fabs(inverse3(a, b)), detpow)
+        f = rate * pow(fabs(det3(a)), detpow)
     shear_force(a, model, out)
     for i in range(9):
         out[i] = -f * out[i]

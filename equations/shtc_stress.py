@@ -15,6 +15,7 @@ Tensors are flat 3x3 (stride 9), the deviator uses tr/3 of the 3x3 tensor also i
 from math import log
 
 from sphgen.equation import Equation, declare, helper
+from sphgen.linalg import dev3, inv3, matmul3, transpose3
 
 from .shtc_velocity_gradient import moment_inverse
 
@@ -22,20 +23,21 @@ MODELS = {"dprz": 0, "neo-hookean": 1}
 
 
 @helper
-def inverse3(a=[0.0], out=[0.0]):
-    """out = a^-1 of a 3x3 matrix; returns det a."""
-    d = (a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6])
-         + a[2] * (a[3] * a[7] - a[4] * a[6]))
-    r = 1.0 / d
-    out[0] = (a[4] * a[8] - a[5] * a[7]) * r
-    out[1] = (a[2] * a[7] - a[1] * a[8]) * r
-    out[2] = (a[1] * a[5] - a[2] * a[4]) * r
-    out[3] = (a[5] * a[6] - a[3] * a[8]) * r
-    out[4] = (a[0] * a[8] - a[2] * a[6]) * r
-    out[5] = (a[2] * a[3] - a[0] * a[5]) * r
-    out[6] = (a[3] * a[7] - a[4] * a[6]) * r
-    out[7] = (a[1] * a[6] - a[0] * a[7]) * r
-    out[8] = (a[0] * a[4] - a[1] * a[3]) * r
+def right_gram(a=[0.0], out=[0.0]):
+    """out = A^T A (the metric G of Kincl et al. (2023), eq. 15)."""
+    t = declare("matrix(9)")
+    transpose3(a, t)
+    matmul3(t, a, out)
+
+
+@helper
+def left_inverse_gram(a=[0.0], out=[0.0]):
+    """out = A^-1 A^-T (the B of the neo-Hookean energy, eq. 17); returns det A."""
+    ai = declare("matrix(9)")
+    t = declare("matrix(9)")
+    d = inv3(a, ai)
+    transpose3(ai, t)
+    matmul3(ai, t, out)
     return d
 
 
@@ -46,32 +48,13 @@ def shear_stress(a=[0.0], model=0, out=[0.0]):
     g = declare("matrix(9)")
     e = declare("matrix(9)")
     if model == 0:
-        for i in range(3):
-            for j in range(3):
-                s = 0.0
-                for k in range(3):
-                    s += a[3 * k + i] * a[3 * k + j]
-                g[3 * i + j] = s
-        tr = (g[0] + g[4] + g[8]) / 3.0
-        for i in range(9):
-            e[i] = g[i]
-        e[0] -= tr
-        e[4] -= tr
-        e[8] -= tr
-        for i in range(3):
-            for j in range(3):
-                s = 0.0
-                for k in range(3):
-                    s += g[3 * i + k] * e[3 * k + j]
-                out[3 * i + j] = s
+        right_gram(a, g)
+        dev3(g, e)
+        matmul3(g, e, out)
     else:
-        inverse3(a, g)
-        for i in range(3):
-            for j in range(3):
-                s = 0.0
-                for k in range(3):
-                    s += g[3 * i + k] * g[3 * j + k]
-                out[3 * i + j] = -s
+        left_inverse_gram(a, g)
+        for i in range(9):
+            out[i] = -g[i]
         out[0] += 1.0
         out[4] += 1.0
         out[8] += 1.0
@@ -83,32 +66,16 @@ def shear_force(a=[0.0], model=0, out=[0.0]):
     neo-Hookean A^-T (I - A^-1 A^-T), i.e. A^-T times :func:`shear_stress`."""
     s = declare("matrix(9)")
     b = declare("matrix(9)")
+    t = declare("matrix(9)")
     if model == 0:
-        for i in range(3):
-            for j in range(3):
-                t = 0.0
-                for k in range(3):
-                    t += a[3 * k + i] * a[3 * k + j]
-                s[3 * i + j] = t
-        t = (s[0] + s[4] + s[8]) / 3.0
-        s[0] -= t
-        s[4] -= t
-        s[8] -= t
-        for i in range(3):
-            for j in range(3):
-                t = 0.0
-                for k in range(3):
-                    t += a[3 * i + k] * s[3 * k + j]
-                out[3 * i + j] = t
+        right_gram(a, s)
+        dev3(s, s)
+        matmul3(a, s, out)
     else:
         shear_stress(a, model, s)
-        inverse3(a, b)
-        for i in range(3):
-            for j in range(3):
-                t = 0.0
-                for k in range(3):
-                    t += b[3 * k + i] * s[3 * k + j]
-                out[3 * i + j] = t
+        inv3(a, b)
+        transpose3(b, t)
+        matmul3(t, s, out)
 
 
 @helper
@@ -116,25 +83,14 @@ def shear_energy(a=[0.0], model=0):
     """eps_s / cs^2: DPRZ |dev(A^T A)|_F^2 / 4 (eq. 15); neo-Hookean (tr B - 3 + 2 ln det A)/2 (eq. 17)."""
     g = declare("matrix(9)")
     if model == 0:
-        for i in range(3):
-            for j in range(3):
-                s = 0.0
-                for k in range(3):
-                    s += a[3 * k + i] * a[3 * k + j]
-                g[3 * i + j] = s
-        tr = (g[0] + g[4] + g[8]) / 3.0
-        g[0] -= tr
-        g[4] -= tr
-        g[8] -= tr
+        right_gram(a, g)
+        dev3(g, g)
         s = 0.0
         for i in range(9):
             s += g[i] * g[i]
         return 0.25 * s
-    d = inverse3(a, g)
-    s = 0.0
-    for i in range(9):
-        s += g[i] * g[i]
-    return 0.5 * (s - 3.0 + 2.0 * log(d))
+    d = left_inverse_gram(a, g)
+    return 0.5 * (g[0] + g[4] + g[8] - 3.0 + 2.0 * log(d))
 
 
 class SHTCStress(Equation):

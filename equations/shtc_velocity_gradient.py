@@ -11,6 +11,7 @@ H is negative definite when a particle has ``dim`` linearly independent neighbou
 tears reports the event instead of producing infinities.
 """
 from sphgen.equation import Equation, declare, helper
+from sphgen.linalg import det3, inv3
 
 SINGULAR_RATIO = 1e-6
 """H counts as singular when det H / (tr H / d)^d < this (1 for an isotropic H, 0 singular)."""
@@ -57,26 +58,13 @@ def moment_inverse(h=[0.0], out=[0.0], dim=2):
     m = (g[0] + g[4] + g[8]) / 3.0
     if m == 0.0:
         return 1.0
-    det = (g[0] * (g[4] * g[8] - g[5] * g[7]) - g[1] * (g[3] * g[8] - g[5] * g[6])
-           + g[2] * (g[3] * g[7] - g[4] * g[6]))
     # H is negative definite: det < 0 and m < 0, det / m^3 in (0, 1]
-    if det / (m * m * m) < 1e-6:
+    if det3(g) / (m * m * m) < 1e-6:
         g[0] += 1e-3 * m
         g[4] += 1e-3 * m
         g[8] += 1e-3 * m
-        det = (g[0] * (g[4] * g[8] - g[5] * g[7]) - g[1] * (g[3] * g[8] - g[5] * g[6])
-               + g[2] * (g[3] * g[7] - g[4] * g[6]))
         flag = 1.0
-    r = 1.0 / det
-    out[0] = (g[4] * g[8] - g[5] * g[7]) * r
-    out[1] = (g[2] * g[7] - g[1] * g[8]) * r
-    out[2] = (g[1] * g[5] - g[2] * g[4]) * r
-    out[3] = (g[5] * g[6] - g[3] * g[8]) * r
-    out[4] = (g[0] * g[8] - g[2] * g[6]) * r
-    out[5] = (g[2] * g[3] - g[0] * g[5]) * r
-    out[6] = (g[3] * g[7] - g[4] * g[6]) * r
-    out[7] = (g[1] * g[6] - g[0] * g[7]) * r
-    out[8] = (g[0] * g[4] - g[1] * g[3]) * r
+    inv3(g, out)
     return flag
 
 

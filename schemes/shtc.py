@@ -27,7 +27,7 @@ import math
 
 import numpy as np
 
-from sphgen.equation import Group
+from sphgen.equation import Group, helper
 from sphgen.errors import InputError
 from sphgen.integrators import Integrator, IntegratorStep
 from sphgen.kernels import get_kernel
@@ -47,8 +47,36 @@ RK4_REAL_STABILITY = 2.785293563405282
 RELAXATION_DT_LIMIT = RK4_REAL_STABILITY / 6.0
 """dt/tau bound of the explicit RK4 relaxation: the stiffest rate at A = I is 6/tau (0.4642)."""
 
+def rk4_factor(z):
+    """Classical RK4's amplification 1 + z + z^2/2 + z^3/6 + z^4/24 of dy/dt = (z/dt) y."""
+    return 1.0 + z + z * z / 2.0 + z ** 3 / 6.0 + z ** 4 / 24.0
+
+
+def viscosity_factor(dt_over_tau):
+    """nu_effective / nu of the step in steady simple shear, linearised about A = I.
+
+    Each step shears A by dt L (Cayley) and then relaxes it by the RK4 factor R = R(-6 dt/tau);
+    the stress is read after the relaxation, so the steady strain is R dt L/(1 - R) instead of
+    tau L/6: nu_eff/nu = 6 (dt/tau) R/(1 - R).  0.86 at dt/tau = 0.05, 0.73 at 0.1 (the
+    paper's cavity), 1 at 1/3, 3.0 at 0.4 (derived here, not in the papers; docs/shtc.md).
+    """
+    r = rk4_factor(-6.0 * dt_over_tau)
+    return 6.0 * dt_over_tau * r / (1.0 - r)
+
+
 THETA_DETPOW = 5.0 / 3.0
 """theta = tau cs^2/3 |det A|^(-5/3) (paper footnote 1; thesis eq. 2.11)."""
+
+
+@helper
+def add_scaled(i=0, dim=3, c=0.0, x=[0.0], y=[0.0], z=[0.0], u=[0.0], v=[0.0], w=[0.0]):
+    """(x, y, z)_i += c (u, v, w)_i on the first ``dim`` components (the kicks and drifts of
+    Kincl et al. (2023), eqs. 25a, b, e, f)."""
+    x[i] += c * u[i]
+    if dim > 1:
+        y[i] += c * v[i]
+    if dim > 2:
+        z[i] += c * w[i]
 
 
 class SHTCStep(IntegratorStep):
@@ -68,20 +96,12 @@ class SHTCStep(IntegratorStep):
     def stage1(self, d_idx, d_u, d_v, d_w, d_au, d_av, d_aw, dt):
         """Kick v += dt/2 a (eq. 25a)."""
         if self.move:
-            d_u[d_idx] += 0.5 * dt * d_au[d_idx]
-            if self.dim > 1:
-                d_v[d_idx] += 0.5 * dt * d_av[d_idx]
-            if self.dim > 2:
-                d_w[d_idx] += 0.5 * dt * d_aw[d_idx]
+            add_scaled(d_idx, self.dim, 0.5 * dt, d_u, d_v, d_w, d_au, d_av, d_aw)
 
     def stage2(self, d_idx, d_x, d_y, d_z, d_u, d_v, d_w, dt):
         """Drift x += dt/2 v (eq. 25b)."""
         if self.move:
-            d_x[d_idx] += 0.5 * dt * d_u[d_idx]
-            if self.dim > 1:
-                d_y[d_idx] += 0.5 * dt * d_v[d_idx]
-            if self.dim > 2:
-                d_z[d_idx] += 0.5 * dt * d_w[d_idx]
+            add_scaled(d_idx, self.dim, 0.5 * dt, d_x, d_y, d_z, d_u, d_v, d_w)
 
     def stage3(self, d_idx, d_x, d_y, d_z, d_u, d_v, d_w, d_A, d_L, dt):
         """A by the Cayley transform (eq. 25c), RK4 relaxation (eq. 25d); drift (eq. 25e)."""
@@ -97,20 +117,12 @@ class SHTCStep(IntegratorStep):
         for i in range(9):
             d_A[9 * d_idx + i] = b[i]
         if self.move:
-            d_x[d_idx] += 0.5 * dt * d_u[d_idx]
-            if self.dim > 1:
-                d_y[d_idx] += 0.5 * dt * d_v[d_idx]
-            if self.dim > 2:
-                d_z[d_idx] += 0.5 * dt * d_w[d_idx]
+            add_scaled(d_idx, self.dim, 0.5 * dt, d_x, d_y, d_z, d_u, d_v, d_w)
 
     def stage4(self, d_idx, d_u, d_v, d_w, d_au, d_av, d_aw, dt):
         """Kick v += dt/2 a (eq. 25f)."""
         if self.move:
-            d_u[d_idx] += 0.5 * dt * d_au[d_idx]
-            if self.dim > 1:
-                d_v[d_idx] += 0.5 * dt * d_av[d_idx]
-            if self.dim > 2:
-                d_w[d_idx] += 0.5 * dt * d_aw[d_idx]
+            add_scaled(d_idx, self.dim, 0.5 * dt, d_u, d_v, d_w, d_au, d_av, d_aw)
 
 
 class SHTCIntegrator(Integrator):
@@ -236,11 +248,11 @@ class SHTCScheme(Scheme):
                 pa.add_property(p, stride=9)
             if not pa.has("A") or "A" not in pa.data:
                 pa.add_property("A", stride=9, data=identity_tensors(pa.n))
-            if pa.name in self.walls:
-                # a wall at rest has v = 0 in L; a moving wall's motion sets its velocity
-                for c in ("u", "v", "w"):
-                    if c not in pa.data:
-                        pa.add_property(c, default=0.0)
+            # unused coordinates are zero (the kicks and drifts pass all three, see add_scaled);
+            # a wall at rest has v = 0 in L, a moving wall's motion sets its velocity
+            for c in ("x", "y", "z", "u", "v", "w"):
+                if c not in pa.data:
+                    pa.add_property(c, default=0.0)
 
     # ---------------------------------------------------------------- equations
     def get_equations(self):

@@ -84,7 +84,9 @@ def run_all(name, todo, directory, jobs, what):
 
 
 def _parser(what, description):
-    p = argparse.ArgumentParser(prog=f"sphgen {what} NAME", description=description)
+    # no abbreviations: an application's option (e.g. --re) must not be taken for one of
+    # these (--reference)
+    p = argparse.ArgumentParser(prog=f"sphgen {what} NAME", description=description, allow_abbrev=False)
     p.add_argument("name", help="the application")
     p.add_argument("-d", "--directory", default=None, help=f"output folder (default NAME_{what})")
     p.add_argument("--jobs", type=int, default=1, help="runs at a time (default 1: serial)")

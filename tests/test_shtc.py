@@ -398,3 +398,24 @@ def test_cp_zero_removes_the_penalty_and_tau_infinity_the_relaxation_from_the_co
     for word in ("MIXEDIJ", "kernel_mixed", "GHIJ", "relax_rk4", "relaxation_rate", "lam"):
         assert word not in src, word
     assert "lam" not in off.allocation["solid"] and "clam" not in off.allocation["solid"]
+
+
+def test_viscosity_factor_of_the_splitting_in_steady_simple_shear():
+    """Cayley shear + RK4 relaxation iterated to the steady state: the shear stress is
+    nu_eff dv/dy with nu_eff/nu = viscosity_factor(dt/tau), not 1 (0.73 at the paper's 0.1)."""
+    from sphgen.schemes.shtc import viscosity_factor
+    nu, cs, rate = 0.01, 10.0, 1.0
+    tau = 6 * nu / cs ** 2
+    L = [0.0, rate, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]      # v_x = rate * y
+    for x in (0.05, 0.1, 1.0 / 3.0, 0.4):
+        a = np.eye(3).ravel().tolist()
+        for _ in range(int(20 / x)):
+            b = [0.0] * 9
+            cayley_update(a, L, x * tau, b)
+            relax_rk4(b, x * tau, 3.0 / tau, 0, 0.0)
+            a = b
+        s = [0.0] * 9
+        shear_stress(a, 0, s)
+        assert abs(cs ** 2 * s[1]) / (nu * rate) == pytest.approx(viscosity_factor(x), rel=2e-3), x
+    assert viscosity_factor(0.1) == pytest.approx(0.7316, abs=1e-4)
+    assert viscosity_factor(1.0 / 3.0) == pytest.approx(1.0, abs=1e-3)

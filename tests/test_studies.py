@@ -45,3 +45,12 @@ def test_stress_fails_when_a_run_blows_up_within_the_stable_factor(tmp_path):
     code = main(["stress", "taylor_green", "--runs", "1", "--nx", "12", "--tf", "0.3", "--no-openmp",
                  "--dt-factor", "40", "--stable-factor", "50", "-d", str(tmp_path)])
     assert code == 1
+
+
+def test_an_application_option_is_not_taken_for_an_abbreviated_study_option():
+    """`--re 2` (taylor_couette's Reynolds number) once became `--reference 2` of precision."""
+    from sphgen.studies import _parse, _parser
+    p = _parser("precision", "")
+    p.add_argument("--reference", default=None)
+    known, rest = _parse(p, ["taylor_couette", "--re", "2", "--nr", "10", "20"])
+    assert known.reference is None and rest == ["--re", "2", "--nr", "10", "20"]
