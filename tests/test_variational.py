@@ -63,7 +63,6 @@ def advance(integ, steps, dt=1e-4):
 
 def test_alpha_one_is_the_explicit_leapfrog():
     """da Silva & Giraldi (2024) eq. 38 / digest A27: alpha = 1 == leapfrog eqs. 59-62."""
-    # one scene at a time: two live scenes of the same generated code share its module's binding
     a, ia, _ = build("explicit", walls=True, gravity=True, periodic=False)
     advance(ia, 8)
     ref = {p: a.data[p].copy() for p in ("x", "y", "u", "v")}
