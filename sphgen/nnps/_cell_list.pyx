@@ -831,10 +831,10 @@ def refine_csr(GridSpec grid, int[::1] offsets, int[::1] nbrs, list dest_coords,
             pts[4 * i + a] = xs[a][i]
         kh = radius_scale * src_h[i]
         pts[4 * i + 3] = kh * kh
-    cdef bint open2 = g.dim == 2 and not (g.periodic[0] or g.periodic[1])
-    cdef bint open3 = g.dim == 3 and not (g.periodic[0] or g.periodic[1] or g.periodic[2])
+    cdef bint open_box = g.dim >= 2 and not (g.periodic[0] or g.periodic[1] or g.periodic[2])
     cdef double xi, yi, zi
-    if open2:     # the common cases without the per-candidate axis tests (same terms)
+    if open_box:  # the common case without the per-candidate axis tests; in 2D the z terms
+        # are 0 - 0 (pts holds 0 there), and adding 0.0 leaves the build's sum unchanged
         for i in prange(nd, nogil=True, schedule="static"):
             start = offsets[i]
             cnt = 0
@@ -842,24 +842,7 @@ def refine_csr(GridSpec grid, int[::1] offsets, int[::1] nbrs, list dest_coords,
             ri2 = kh * kh
             xi = xd[0][i]
             yi = xd[1][i]
-            for k in range(start, offsets[i + 1]):
-                q = pts + 4 * nbrs[k]
-                dx = xi - q[0]
-                dy = yi - q[1]
-                r2 = dx * dx + dy * dy
-                tmp[start + cnt] = nbrs[k]
-                cnt = cnt + (r2 < (ri2 if ri2 > q[3] else q[3]))
-            counts[i] = <int>cnt
-        return _compact(offsets, counts, tmp, nd)
-    if open3:
-        for i in prange(nd, nogil=True, schedule="static"):
-            start = offsets[i]
-            cnt = 0
-            kh = radius_scale * dest_h[i]
-            ri2 = kh * kh
-            xi = xd[0][i]
-            yi = xd[1][i]
-            zi = xd[2][i]
+            zi = xd[2][i] if g.dim == 3 else 0.0
             for k in range(start, offsets[i + 1]):
                 q = pts + 4 * nbrs[k]
                 dx = xi - q[0]
