@@ -223,7 +223,7 @@ def test_momentum_conserved_to_round_off_without_the_divergence_term(corrections
 
 
 def test_momentum_drift_with_the_divergence_term(capsys):
-    """-u div(u~ - u) is not antisymmetric: report its drift (docs/validation_ctvf.md)."""
+    """-u div(u~ - u) is not antisymmetric: report its drift (docs/ctvf.md)."""
     drift = momentum_drift(("edac", "stress", "divergence"))
     with capsys.disabled():
         print(f"\nCTVF (SPST, all corrections), 40 steps on a jittered cloud: "
@@ -351,7 +351,7 @@ def test_short_taylor_green_run(tmp_path, nx, extra, l1max, umax):
     (100, ("--shifting", "spst"), dict(l1=0.01, l1max=0.08, umax=0.01)),
 ], ids=["ipst-nx50", "spst-nx100"])
 def test_taylor_green_re100_to_t2(tmp_path, nx, extra, bounds):
-    """docs/validation_ctvf.md: Re 100, t = 2 (measured: IPST nx 50 L1 0.0095, max 0.070,
+    """docs/ctvf.md: Re 100, t = 2 (measured: IPST nx 50 L1 0.0095, max 0.070,
     max|u| +1.04 %; SPST nx 100 L1 0.0046, max 0.069, max|u| +0.14 %)."""
     res, _ = run_tg(tmp_path, "--scheme", "ctvf", *extra, "--no-openmp", nx=nx, tf=2.0)
     assert res["l1_error"] <= bounds["l1"] and res["l1_error_max"] <= bounds["l1max"], res
