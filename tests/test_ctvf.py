@@ -356,3 +356,31 @@ def test_taylor_green_re100_to_t2(tmp_path, nx, extra, bounds):
     res, _ = run_tg(tmp_path, "--scheme", "ctvf", *extra, "--no-openmp", nx=nx, tf=2.0)
     assert res["l1_error"] <= bounds["l1"] and res["l1_error_max"] <= bounds["l1max"], res
     assert abs(res["max_u_rel_error"]) <= bounds["umax"], res
+
+
+# ------------------------------------------- issue 9, beyond the paper: whole-run errors
+def tg_whole_run(tmp_path, scheme, re, *extra, nx=50):
+    res, _ = run_tg(tmp_path / f"{scheme}{re}{''.join(extra)}", "--scheme", scheme, "--re", str(re),
+                    *extra, "--threads", "1", nx=nx, tf=2.0)
+    return res
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("re", [100, 1000])
+def test_ctvf_largest_l1_below_edac_and_gtvf(tmp_path, re):
+    """nx 50, t = 2, largest L1 over the run (docs/ctvf.md): CTVF + SPST 0.105 (Re 100) and
+    0.122 (Re 1000), EDAC 0.113 and 0.139, GTVF 0.352 and 0.399."""
+    ctvf = tg_whole_run(tmp_path, "ctvf", re)["l1_error_max"]
+    assert ctvf < tg_whole_run(tmp_path, "edac", re)["l1_error_max"]
+    assert ctvf < tg_whole_run(tmp_path, "gtvf", re)["l1_error_max"]
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(reason="measured (docs/ctvf.md): max|u| of CTVF + SPST at nx 50, Re 100 is 8.2 % below "
+                   "the exact decay at t = 0.2 (EDAC 5.6 %, IPST 5.8 %)", strict=False)
+def test_ctvf_max_u_within_three_percent_of_the_exact_decay(tmp_path):
+    """Issue 9: max|u| within 3 % of exp(-8 pi^2 t / Re) over the whole run."""
+    tg_whole_run(tmp_path, "ctvf", 100)
+    with open(tmp_path / "ctvf100" / "tg" / "history.json") as f:
+        rows = np.array(json.load(f)["rows"])
+    assert np.abs(rows[:, 1] / rows[:, 2] - 1).max() < 0.03
