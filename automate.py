@@ -6,11 +6,12 @@ Simulations go to ``outputs/``, figures to ``manuscript/figures/``.  Finished ca
 """
 from automan.api import Automator
 
+from automation.ctvf_cavity import CTVFCavityVoid
 from automation.ctvf_taylor_green import CTVFTaylorGreen
 from automation.taylor_green import TaylorGreenEDAC
 from automation.variational import VariationalDamBreak, VariationalEnergy, VariationalOrder
 
-PROBLEMS = [TaylorGreenEDAC, CTVFTaylorGreen, VariationalDamBreak, VariationalOrder, VariationalEnergy]
+PROBLEMS = [TaylorGreenEDAC, CTVFTaylorGreen, CTVFCavityVoid, VariationalDamBreak, VariationalOrder, VariationalEnergy]
 
 if __name__ == "__main__":
     Automator(simulation_dir="outputs", output_dir="manuscript/figures",

@@ -44,3 +44,22 @@ def test_order_and_summary_from_partial_runs(tmp_path):
     assert set(s["baselines"]["re1000_nx50"]) == {"CTVF SPST", "EDAC"}
     for name in ("fig09_re1000_spst.png", "fig10_spst_corrections.png", "baselines.png", "summary.md"):
         assert os.path.getsize(tmp_path / "fig" / name) > 100
+
+
+def test_cavity_void_figure_from_finished_runs(tmp_path):
+    """automation/ctvf_cavity.py: the Fig. 13 pair, titled with its largest empty disc."""
+    from automation.ctvf_cavity import case_params, figure
+    from sphgen import io
+    from sphgen.particles import ParticleArray
+    assert "no_corrections" in case_params(corrections=False) and case_params()["nx"] == 150
+    sim = tmp_path / "sim"
+    folder = sim / "nx20"
+    os.makedirs(folder)
+    x, y = np.random.default_rng(0).uniform(0, 1, (2, 400))
+    io.write(str(folder / "cavity_000100.h5"), [ParticleArray("fluid", x=x, y=y, u=x, v=y)],
+             {"t": 2.0, "dt": 0.01, "step": 100})
+    with open(folder / "results.json", "w") as f:
+        json.dump({"t": 2.0, "largest_empty_disc_over_dx": 1.7}, f)
+    out = figure(str(sim), str(tmp_path / "fig"), nx=20)
+    assert out == {"nx20": {"t": 2.0, "largest_empty_disc_over_dx": 1.7}}     # nx20_nocorr: not run
+    assert os.path.getsize(tmp_path / "fig" / "fig13_cavity_void.png") > 1000
