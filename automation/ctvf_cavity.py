@@ -13,6 +13,7 @@ import sys
 
 import numpy as np
 
+from .ctvf_taylor_green import particle_plot
 from .tasks import SphgenProblem, Simulation
 
 NX = 150
@@ -46,12 +47,10 @@ def figure(sim_dir, out_dir, nx=NX):
             ax.set_title(f"{label}: not run")
             continue
         fl = io.load(last)["arrays"]["fluid"]
-        sc = ax.scatter(fl.x, fl.y, c=np.hypot(fl.u, fl.v), s=0.5, cmap="jet")
         void = res["largest_empty_disc_over_dx"]
         out[name] = {"t": res["t"], "largest_empty_disc_over_dx": void}
-        ax.set_title(f"{label}, t = {res['t']:.3g}: largest empty disc {void:.2f} dx")
-        ax.set_aspect("equal")
-        f.colorbar(sc, ax=ax, label="|u|")
+        particle_plot(f, ax, fl, np.hypot(fl.u, fl.v), "|u|",
+                      f"{label}, t = {res['t']:.3g}: largest empty disc {void:.2f} dx")
     f.suptitle(f"Fig. 13: cavity Re = 100, {nx} x {nx}")
     f.tight_layout()
     f.savefig(os.path.join(out_dir, "fig13_cavity_void.png"), dpi=120)

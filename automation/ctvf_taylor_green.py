@@ -189,6 +189,14 @@ def summary_table(summary):
     return "\n".join(lines) + "\n"
 
 
+def particle_plot(fig, ax, pa, values, label, title):
+    """Particles of ``pa`` coloured by ``values``, with a colour bar, on equal axes."""
+    sc = ax.scatter(pa.x, pa.y, c=values, s=0.5, cmap="jet")
+    fig.colorbar(sc, ax=ax, label=label)
+    ax.set_aspect("equal")
+    ax.set_title(title)
+
+
 def _pressure_plot(plt, folder, path):
     from sphgen import io
     try:
@@ -196,12 +204,9 @@ def _pressure_plot(plt, folder, path):
     except (IndexError, OSError):
         return
     data = io.load(last)
-    fl, t = data["arrays"]["fluid"], data["solver_data"]["t"]
     f, ax = plt.subplots(figsize=(5.5, 4.5))
-    sc = ax.scatter(fl["x"], fl["y"], c=fl["p"], s=1, cmap="jet")
-    f.colorbar(sc, ax=ax, label="p")
-    ax.set_aspect("equal")
-    ax.set_title(f"Fig. 12: Re = 1000, t = {t:.3g}")
+    fl = data["arrays"]["fluid"]
+    particle_plot(f, ax, fl, fl.p, "p", f"Fig. 12: Re = 1000, t = {data['solver_data']['t']:.3g}")
     f.tight_layout()
     f.savefig(path, dpi=120)
     plt.close(f)

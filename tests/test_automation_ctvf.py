@@ -36,13 +36,19 @@ def test_order_and_summary_from_partial_runs(tmp_path):
     fake_run(sim / case_name(1000, "ctvf", "spst", 100), 0.01, umax_dev=-0.02)
     fake_run(sim / case_name(1000, "ctvf", "spst", 150), 0.001, completed=False)   # not finished
     fake_run(sim / case_name(1000, "edac", nx=50), 0.08)
+    from sphgen import io
+    from sphgen.particles import ParticleArray
+    x, y = np.random.default_rng(0).uniform(0, 1, (2, 100))
+    io.write(str(sim / case_name(1000, "ctvf", "spst", 150) / "taylor_green_000010.h5"),
+             [ParticleArray("fluid", x=x, y=y, p=x * y)], {"t": 2.0, "dt": 0.01, "step": 10})
     s = figures(str(sim), str(tmp_path / "fig"))
     assert s["orders"]["re1000_spst"]["order"] == [{"nx": [50, 100], "p": pytest.approx(2.0)}]
     assert case_name(1000, "ctvf", "spst", 150) in s["missing"]
     r = s["runs"][case_name(1000, "ctvf", "spst", 100)]
     assert r["l1_final"] == pytest.approx(0.01) and r["max_u_dev_max"] == pytest.approx(0.02)
     assert set(s["baselines"]["re1000_nx50"]) == {"CTVF SPST", "EDAC"}
-    for name in ("fig09_re1000_spst.png", "fig10_spst_corrections.png", "baselines.png", "summary.md"):
+    for name in ("fig09_re1000_spst.png", "fig10_spst_corrections.png", "baselines.png", "summary.md",
+                 "fig12_re1000_pressure.png"):
         assert os.path.getsize(tmp_path / "fig" / name) > 100
 
 
