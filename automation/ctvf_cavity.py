@@ -50,7 +50,7 @@ def figure(sim_dir, out_dir, nx=NX):
         void = res["largest_empty_disc_over_dx"]
         out[name] = {"t": res["t"], "largest_empty_disc_over_dx": void}
         particle_plot(f, ax, fl, np.hypot(fl.u, fl.v), "|u|",
-                      f"{label}, t = {res['t']:.3g}: largest empty disc {void:.2f} dx")
+                      f"{label}, t = {res['t']:.3g}\nlargest empty disc {void:.2f} dx")
     f.suptitle(f"Fig. 13: cavity Re = 100, {nx} x {nx}")
     f.tight_layout()
     f.savefig(os.path.join(out_dir, "fig13_cavity_void.png"), dpi=120)
