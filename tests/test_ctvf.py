@@ -384,3 +384,26 @@ def test_ctvf_max_u_within_three_percent_of_the_exact_decay(tmp_path):
     with open(tmp_path / "ctvf100" / "tg" / "history.json") as f:
         rows = np.array(json.load(f)["rows"])
     assert np.abs(rows[:, 1] / rows[:, 2] - 1).max() < 0.03
+
+
+@pytest.mark.slow
+def test_ctvf_re1000_l1_falls_with_resolution(tmp_path, capsys):
+    """Adepu & Ramachandran (2021) Fig. 9: Re 1000, SPST, t = 2 (measured, docs/ctvf.md:
+    0.0929 at 50 x 50, 0.0226 at 100 x 100, order 2.04)."""
+    e50 = tg_whole_run(tmp_path, "ctvf", 1000, nx=50)["l1_error"]
+    e100 = tg_whole_run(tmp_path / "100", "ctvf", 1000, nx=100)["l1_error"]
+    with capsys.disabled():
+        print(f"\nTaylor-Green Re 1000 CTVF + SPST, t = 2: L1 {e50:.4f} (50), {e100:.4f} (100), "
+              f"order {np.log(e50 / e100) / np.log(2):.2f}")
+    assert e100 < e50
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(reason="measured (docs/ctvf.md): at 100 x 100, Re 1000, SPST the run without corrections "
+                   "ends lower (L1 0.0113 against 0.0226 with them); the -u div(delta) term raises it",
+                   strict=False)
+def test_ctvf_corrections_lower_the_l1_error(tmp_path):
+    """Adepu & Ramachandran (2021) Fig. 10 (at 150 x 150 there; 100 x 100 here)."""
+    with_ = tg_whole_run(tmp_path, "ctvf", 1000, nx=100)["l1_error"]
+    without = tg_whole_run(tmp_path, "ctvf", 1000, "--no-corrections", nx=100)["l1_error"]
+    assert with_ < without
