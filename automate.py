@@ -6,10 +6,13 @@ Simulations go to ``outputs/``, figures to ``manuscript/figures/``.  Finished ca
 """
 from automan.api import Automator
 
+from automation.ctvf_cavity import CTVFCavityVoid
+from automation.ctvf_taylor_green import CTVFTaylorGreen
 from automation.taylor_green import TaylorGreenEDAC
 from automation.variational import VariationalDamBreak, VariationalEjection, VariationalEnergy, VariationalOrder
 
-PROBLEMS = [TaylorGreenEDAC, VariationalDamBreak, VariationalOrder, VariationalEnergy, VariationalEjection]
+PROBLEMS = [TaylorGreenEDAC, CTVFTaylorGreen, CTVFCavityVoid, VariationalDamBreak, VariationalOrder,
+            VariationalEnergy, VariationalEjection]
 
 if __name__ == "__main__":
     Automator(simulation_dir="outputs", output_dir="manuscript/figures",

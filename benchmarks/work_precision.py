@@ -7,6 +7,11 @@ final-time L1 and, for sphgen, its time average over the run are reported: the
 final-time value carries acoustic oscillations of period L/c0.
 
     python benchmarks/work_precision.py [--out outputs/work_precision] [--no-pysph]
+        [--pysph-scheme edac --pysph-scheme gtvf] [--write-reference]
+
+``--write-reference`` stores PySPH's points (one series per ``--pysph-scheme``) in
+``sphgen/tools/reference/pysph_taylor_green.json``, which ``sphgen precision taylor_green
+--error l1_error --tf 0.5`` plots beside sphgen's runs.
 """
 import argparse
 import json
@@ -18,6 +23,18 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from pysph_baseline import find_pysph_python, run_pysph  # noqa: E402
 
 NXS = (25, 50, 100)
+REFERENCE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "sphgen", "tools", "reference",
+                         "pysph_taylor_green.json")
+
+
+def reference_points(by_scheme, tf):
+    """The reference file of ``sphgen precision`` from {scheme: [{nx, wall_s, l1}]} of PySPH runs."""
+    series = {f"PySPH 1.0b2 {scheme.upper()}": [{"label": r["nx"], "wall_time": r["wall_s"], "error": r["l1"]}
+                                                for r in rows if r.get("wall_s") and r.get("l1")]
+              for scheme, rows in by_scheme.items()}
+    return {"source": "PySPH 1.0b2, `pysph run taylor_green --scheme S --nx N --re 100 --tf %g`, 2 threads, "
+            "output every 50 steps; `python benchmarks/work_precision.py --write-reference`. Wall time is "
+            "PySPH's 'Run took'." % tf, "error_key": "l1_error", "tf": tf, "series": series}
 
 
 def sphgen_case(nx, tf, out, threads=2):
@@ -37,18 +54,27 @@ def main(argv=None):
     p.add_argument("--out", default="outputs/work_precision")
     p.add_argument("--tf", type=float, default=0.5)
     p.add_argument("--no-pysph", action="store_true")
+    p.add_argument("--pysph-scheme", action="append", choices=("edac", "gtvf"), default=None,
+                   help="PySPH scheme(s) to run (default edac)")
+    p.add_argument("--write-reference", action="store_true",
+                   help="store PySPH's points as the reference of `sphgen precision taylor_green`")
     o = p.parse_args(argv)
     os.makedirs(o.out, exist_ok=True)
     rows = {"sphgen": [sphgen_case(nx, o.tf, o.out) for nx in NXS]}
     py = None if o.no_pysph else find_pysph_python()
-    if py:
-        rows["pysph"] = []
+    pysph = {}
+    for scheme in (o.pysph_scheme or ["edac"]) if py else []:
+        code = "pysph" if scheme == "edac" else f"pysph_{scheme}"
+        rows[code] = pysph[scheme] = []
         for nx in NXS:
-            r = run_pysph(py, nx=nx, tf=o.tf, openmp=True, threads=2, with_error=True,
-                          workdir=os.path.join(o.out, f"pysph_nx{nx}"))
+            r = run_pysph(py, nx=nx, tf=o.tf, openmp=True, threads=2, with_error=True, scheme=scheme,
+                          workdir=os.path.join(o.out, f"{code}_nx{nx}"))
             e = r.get("error") or {}
-            rows["pysph"].append({"nx": nx, "wall_s": r.get("run_s"), "l1": e.get("l1"),
+            pysph[scheme].append({"nx": nx, "wall_s": r.get("run_s"), "l1": e.get("l1"),
                                   "max_u_rel": (e["decay"] / e["decay_ex"] - 1) if e.get("decay") else None})
+    if o.write_reference and pysph:
+        with open(REFERENCE, "w") as f:
+            json.dump(reference_points(pysph, o.tf), f, indent=1)
     with open(os.path.join(o.out, "work_precision.json"), "w") as f:
         json.dump(rows, f, indent=1)
     print(f"{'code':8s}{'nx':>5s}{'wall s':>9s}{'L1(tf)':>9s}{'L1 mean':>9s}{'max|u| err':>12s}")

@@ -54,3 +54,19 @@ def test_an_application_option_is_not_taken_for_an_abbreviated_study_option():
     p.add_argument("--reference", default=None)
     known, rest = _parse(p, ["taylor_couette", "--re", "2", "--nr", "10", "20"])
     assert known.reference is None and rest == ["--re", "2", "--nr", "10", "20"]
+
+
+def test_pysph_reference_file_has_one_series_per_scheme(tmp_path):
+    """benchmarks/work_precision.py --write-reference: the file `sphgen precision` plots."""
+    import sys
+    sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "benchmarks"))
+    from work_precision import reference_points
+    from sphgen.studies import _reference
+    ref = reference_points({"edac": [{"nx": 25, "wall_s": 3.0, "l1": 0.02}, {"nx": 50, "wall_s": None, "l1": 0.1}],
+                            "gtvf": [{"nx": 25, "wall_s": 4.0, "l1": 0.03}]}, 0.5)
+    path = tmp_path / "ref.json"
+    path.write_text(json.dumps(ref))
+    back = _reference(str(path), "taylor_green")
+    assert back["error_key"] == "l1_error" and back["tf"] == 0.5
+    assert back["series"] == {"PySPH 1.0b2 EDAC": [{"label": 25, "wall_time": 3.0, "error": 0.02}],
+                              "PySPH 1.0b2 GTVF": [{"label": 25, "wall_time": 4.0, "error": 0.03}]}
