@@ -33,32 +33,48 @@ SPHGEN = os.path.join(os.path.dirname(sys.executable), "sphgen")
 CONFIGS = {"sphgen": [], "sphgen-pysph-physics": ["--delta", "0", "--kernel", "wendland", "--hdx", "1.3"]}
 
 
-def sphgen_run(work, tf, threads, config="sphgen"):
-    out = os.path.join(work, f"{config}_t{threads}")
-    cmd = [SPHGEN, "run", "dam_break_2d", "--tf", str(tf), "--disable-output", "--no-progress",
-           "--overwrite", "-d", out] + CONFIGS[config]
+def sphgen_app(work, app, args, threads, label):
+    """One ``sphgen run APP`` as a subprocess: wall time of the time loop, steps, particles, pairs/s."""
+    out = os.path.join(work, f"{label}_t{threads}")
+    cmd = [SPHGEN, "run", app, "--disable-output", "--no-progress", "--overwrite", "-d", out] + list(args)
     cmd += ["--no-openmp"] if threads == 1 else ["--threads", str(threads)]
     subprocess.run(cmd, check=True, capture_output=True, env=dict(os.environ, SPHGEN_TUNE_THREADS="0"))
     info = json.load(open(os.path.join(out, "info.json")))
     n, steps, wall = info["n_particles"], info["steps"], info["wall_time"]
-    return {"wall": wall, "steps": steps, "n": n, "fluid": info["particles"]["fluid"],
+    return {"wall": wall, "steps": steps, "n": n, "fluid": info["particles"].get("fluid", n),
             "pairs_per_s": info["neighbour_pairs_per_step"] * steps / wall, "info": info}
 
 
-def pysph_run(py, work, tf, threads):
-    out = os.path.join(work, f"pysph_t{threads}")
+def sphgen_run(work, tf, threads, config="sphgen"):
+    return sphgen_app(work, "dam_break_2d", ["--tf", str(tf)] + CONFIGS[config], threads, config)
+
+
+def pysph_app(py, work, app, args, threads, label="pysph"):
+    """One ``pysph run APP`` (PySPH 1.0b2): wall time it prints, steps from its profile, particles."""
+    out = os.path.join(work, f"{label}_t{threads}")
     exe = os.path.join(os.path.dirname(py), "pysph")
-    cmd = [exe, "run", "dam_break_2d", "--tf", str(tf), "--disable-output", "-d", out]
+    cmd = [exe, "run", app, "--disable-output", "-d", out] + list(args)
     cmd += ["--openmp", "--omp-schedule", "static"] if threads > 1 else []
     env = dict(os.environ, OMP_NUM_THREADS=str(threads))
     p = subprocess.run(cmd, check=True, capture_output=True, text=True, env=env, cwd=work)
     wall = float(p.stdout.split("Run took:")[1].split()[0])
-    fluid = int(p.stdout.split("fluid:")[1].split()[0])
-    n = int(p.stdout.split("Total:")[1].split()[0])
+    counts = particle_counts(p.stdout)
+    n = int(p.stdout.split("Total:")[1].split()[0]) if "Total:" in p.stdout else sum(counts.values())
+    fluid = counts.get("fluid", n)
     with open(os.path.join(out, "profile_info.csv")) as f:
         calls = {r["function"]: int(r["calls"]) for r in csv.DictReader(f)}
     steps = calls["Solver._get_timestep"] - 1
     return {"wall": wall, "steps": steps, "n": n, "fluid": fluid}
+
+
+def particle_counts(stdout):
+    """{array: particles} from PySPH's "No of particles:" block."""
+    block = stdout.split("No of particles:")[1].split("-----")[0]
+    return {k.strip(): int(v) for k, v in (line.split(":") for line in block.splitlines() if ":" in line)}
+
+
+def pysph_run(py, work, tf, threads):
+    return pysph_app(py, work, "dam_break_2d", ["--tf", str(tf)], threads)
 
 
 def med(rows, key):
