@@ -6,7 +6,7 @@ the generated code as constants, so the compiled kernel is specialised on the di
 ``methods`` go into every module; ``extra_methods`` only into a module whose equations ask
 for a pair symbol that calls them (``MIXEDIJ``).
 """
-from math import pi
+from math import fabs, pi
 
 
 class Kernel:
@@ -62,33 +62,30 @@ class QuinticSpline(Kernel):
         self.fac = {1: 1.0 / 120.0, 2: 7.0 / (478.0 * pi), 3: 1.0 / (120.0 * pi)}[dim]
 
     def w(self, rij=1.0, h=1.0):
-        """W(r, h) = sigma/h^d [(3-q)^5 - 6(2-q)^5 + 15(1-q)^5] on the pieces of q = r/h."""
+        """W(r, h) = sigma/h^d [(3-q)+^5 - 6(2-q)+^5 + 15(1-q)+^5], q = r/h, (x)+ = max(x, 0).
+
+        No branch on the piece of q: (x)+ = (x + |x|)/2 exactly, and a piece that is off adds an
+        exact 0 (a neighbour's piece is random, so branches on it are mispredicted)."""
         q = rij / h
-        t3 = 3.0 - q
-        t2 = 2.0 - q
-        t1 = 1.0 - q
-        val = 0.0
-        if q < 1.0:
-            val = t3 * t3 * t3 * t3 * t3 - 6.0 * t2 * t2 * t2 * t2 * t2 + 15.0 * t1 * t1 * t1 * t1 * t1
-        elif q < 2.0:
-            val = t3 * t3 * t3 * t3 * t3 - 6.0 * t2 * t2 * t2 * t2 * t2
-        elif q < 3.0:
-            val = t3 * t3 * t3 * t3 * t3
+        t3 = 0.5 * (3.0 - q + fabs(3.0 - q))
+        t2 = 0.5 * (2.0 - q + fabs(2.0 - q))
+        t1 = 0.5 * (1.0 - q + fabs(1.0 - q))
+        t3s = t3 * t3
+        t2s = t2 * t2
+        t1s = t1 * t1
+        val = t3s * t3s * t3 - 6.0 * t2s * t2s * t2 + 15.0 * t1s * t1s * t1
         return self.sigma(h) * val
 
     def dwdr(self, rij=1.0, h=1.0):
-        """dW/dr = -5 sigma/h^(d+1) [(3-q)^4 - 6(2-q)^4 + 15(1-q)^4] on the same pieces."""
+        """dW/dr = -5 sigma/h^(d+1) [(3-q)+^4 - 6(2-q)+^4 + 15(1-q)+^4], branch-free as w."""
         q = rij / h
-        a = 3.0 - q
-        b = 2.0 - q
-        c = 1.0 - q
-        val = 0.0
-        if q < 1.0:
-            val = a * a * a * a - 6.0 * b * b * b * b + 15.0 * c * c * c * c
-        elif q < 2.0:
-            val = a * a * a * a - 6.0 * b * b * b * b
-        elif q < 3.0:
-            val = a * a * a * a
+        a = 0.5 * (3.0 - q + fabs(3.0 - q))
+        b = 0.5 * (2.0 - q + fabs(2.0 - q))
+        c = 0.5 * (1.0 - q + fabs(1.0 - q))
+        a2 = a * a
+        b2 = b * b
+        c2 = c * c
+        val = a2 * a2 - 6.0 * b2 * b2 + 15.0 * c2 * c2
         return -5.0 * self.sigma(h) * val / h
 
     def gradh(self, rij=1.0, h=1.0):
