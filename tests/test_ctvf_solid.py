@@ -355,6 +355,16 @@ def test_rings_coarse_collide_rebound_and_separate(tmp_path):
     assert res["bounced"] and res["separated"] and res["gap_final_over_dx"] > 1.0, res
 
 
+def test_rings_one_body_keeps_pysph_single_array(tmp_path):
+    """--one-body: both rings in one array (PySPH's rings), no contact force, same count."""
+    res, rows, app = run_app("rings", tmp_path, "--dx", "0.004", "--tf", "0.001", "--record-every", "0.0005",
+                             "--one-body")
+    kept = {type(ep.eq).__name__ for ep in app.scene.plan.eqplans if ep.kept}
+    assert "ContactForce" not in kept and list(app.scene.by_name) == ["rings"]
+    assert res["n_particles"] == 256 and res["contact"] is False and np.all(rows[:, 10] == 0.0)
+    assert res["reached_end"] and res["u_left_final"] > 0 > res["u_right_final"]
+
+
 def test_perfect_plasticity_returns_to_the_von_mises_surface():
     from sphgen.equations.elastic import PerfectPlasticity
     pa = solid_cloud(nx=4)
