@@ -288,6 +288,21 @@ def test_coarse_plate_bends_from_the_clamp(tmp_path):
     assert res["period"] is None            # not a full period yet
 
 
+def test_perturbed_plate_keeps_its_tip_clamp_and_bonds(tmp_path):
+    """`sphgen stress` perturbs the plate (0.2 dx): the tip, the clamp and the bonds of the
+    separation measure are those of the lattice, so the tip is followed (it was lost
+    before) and the clamp columns are unmoved."""
+    res, rows, app = run_app("oscillating_plate", tmp_path, "--nh", "4", "--tf", "0.004", "--record-every", "0.002",
+                             "--perturb", "0.2", "--seed", "3")
+    assert np.all(np.isfinite(rows[:, 1])) and rows[-1, 1] > 0 and len(app.tip.gids) == 2
+    pa = app.scene.by_name["plate"]
+    held = np.isin(pa.gid, app.clamp_gids)
+    assert held.sum() == 3 * 4 and np.all(pa.v[held] == 0)
+    ncol = pa.n // 4
+    assert len(app.bonds) == 3 * ncol + 4 * (ncol - 1)        # the lattice's nearest-neighbour pairs
+    assert res["separation"]["pieces_max"] == 1 and not res["separated"]
+
+
 def test_contact_force_pushes_and_never_pulls():
     """Two bodies: a pair closer than d0 is pushed apart by k (d0 - r) along x_ab, equal and
     opposite; a pair farther apart (an opening contact) feels nothing: no tension."""
