@@ -384,7 +384,8 @@ class ElasticSolids:
     the momentum group is eq. 30 (pressure, deviatoric stress, Monaghan artificial
     viscosity with beta = 0, body force, homogenisation); the drift evolves ``sd``
     (eq. 58); ``clamped`` ({array: gids}) particles are held at u = u~ = 0 by the
-    integrator after every stage; ``yield_stress`` Y0 (if given) limits the updated
+    integrator after every stage, ``driven`` ({array: (gids, velocity)}) particles at that
+    constant velocity (u = u~: they move with it, a piston); ``yield_stress`` Y0 (if given) limits the updated
     stress to the von Mises surface (section 4.7).  ``contact``: each medium is a body of
     its own (every SPH sum over that medium alone) and the bodies touch only through
     :class:`~sphgen.equations.contact.ContactForce` (push, no tension; d0 = dx, k =
@@ -393,7 +394,7 @@ class ElasticSolids:
     transport_gradient = False
     output_props = ("x", "y", "z", "u", "v", "w", "p", "rho", "m", "h", "sd")
 
-    def _init_solid(self, G, clamped, jaumann_correction, yield_stress=None, contact=False):
+    def _init_solid(self, G, clamped, jaumann_correction, yield_stress=None, contact=False, driven=None):
         if self.walls:
             raise ValueError(f"{type(self).__name__}: wall arrays for solids (stress extrapolation, eq. 53) "
                              "are not implemented; hold boundary particles with clamped={array: gids}")
@@ -411,6 +412,12 @@ class ElasticSolids:
         if contact and len(self.fluids) < 2:
             raise ValueError(f"{type(self).__name__}: contact needs at least two bodies (arrays), got {self.fluids}")
         self.contact = bool(contact)
+        self.driven = {a: (list(g), tuple(float(c) for c in vel)) for a, (g, vel) in dict(driven or {}).items()}
+        bad = sorted(set(self.driven) - set(self.fluids))
+        if bad:
+            raise ValueError(f"{type(self).__name__}: driven array {bad[0]!r} is not among {self.fluids}")
+        if any(len(vel) != self.dim for _, vel in self.driven.values()):
+            raise ValueError(f"{type(self).__name__}: driven velocities need {self.dim} components")
 
     def parameters(self):
         out = super().parameters()
@@ -481,6 +488,8 @@ class ElasticSolids:
         held = {p: 0.0 for vel in ("u", "v", "w")[:self.dim] for p in (vel, vel + "hat")}
         for array, gids in self.clamped.items():
             integrator.clamp(array, gids, **held)
+        for array, (gids, vel) in self.driven.items():
+            integrator.clamp(array, gids, **{p: c for v, c in zip(("u", "v", "w"), vel) for p in (v, v + "hat")})
         return integrator
 
     def stability_bounds(self, dt):
@@ -499,7 +508,8 @@ class CTVFSolidScheme(ElasticSolids, CTVFScheme):
     artificial viscosity ``alpha`` (paper: 1), SPST (default) or IPST, kick-drift-kick,
     time step eq. 62 (``umax`` is the largest expected speed).  ``corrections``: subset of
     :data:`SOLID_CORRECTIONS`.  ``free_surface`` (default on): the surface treatment of
-    sections 3.4-3.5 as for fluids.  ``clamped``: {array: gids} held fixed.
+    sections 3.4-3.5 as for fluids.  ``clamped``: {array: gids} held fixed; ``driven``:
+    {array: (gids, velocity)} moved at a constant velocity.
     ``edac_damping``: 'paper' (default) is the printed eq. 26, whose damping term carries
     an extra 1/rho against the Laplacian (nu_edac / rho0 here: rho stays within 1% of
     rho0); 'consistent' is the fluid scheme's form.  For rho0 = 1000 the consistent
@@ -512,7 +522,7 @@ class CTVFSolidScheme(ElasticSolids, CTVFScheme):
 
     def __init__(self, solids, dim, rho0, E, poisson, h, dx, umax=1.0, shifting="spst", alpha=1.0,
                  corrections=SOLID_CORRECTIONS, clamped=None, free_surface=True, edac_damping="paper",
-                 yield_stress=None, contact=False, **kw):
+                 yield_stress=None, contact=False, driven=None, **kw):
         if edac_damping not in ("paper", "consistent"):
             raise ValueError(f"edac_damping must be 'paper' or 'consistent', got {edac_damping!r}")
         self.edac_damping = edac_damping
@@ -525,7 +535,7 @@ class CTVFSolidScheme(ElasticSolids, CTVFScheme):
         super().__init__(solids, dim, rho0, c0, 0.0, h, dx, umax=umax, shifting=shifting,
                          corrections=fluid_corrections, density="continuity", alpha=alpha,
                          free_surface=free_surface and shifting != "ipst", **kw)
-        self._init_solid(G, clamped or {}, "jaumann" in corrections, yield_stress, contact)
+        self._init_solid(G, clamped or {}, "jaumann" in corrections, yield_stress, contact, driven)
 
     def nu_edac(self):
         """Eq. 24, divided by rho0 for the printed form of eq. 26 (``edac_damping='paper'``)."""

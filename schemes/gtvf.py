@@ -108,12 +108,12 @@ class GTVFSolidScheme(ElasticSolids, GTVFScheme):
     transport_gradient = True
 
     def __init__(self, solids, dim, rho0, E, poisson, h, dx, umax=1.0, shifting="gtvf", alpha=1.0,
-                 clamped=None, yield_stress=None, contact=False, **kw):
+                 clamped=None, yield_stress=None, contact=False, driven=None, **kw):
         c0, G = elastic_constants(E, poisson, rho0)
         self.E, self.poisson = E, poisson
         super().__init__(solids, dim, rho0, c0, 0.0, h, dx, umax=umax, shifting=shifting,
                          density="continuity", alpha=alpha, **kw)
-        self._init_solid(G, clamped or {}, False, yield_stress, contact)
+        self._init_solid(G, clamped or {}, False, yield_stress, contact, driven)
 
     def _density_groups(self):
         """p = c0^2 (rho - rho0), rho from the continuity equation."""
