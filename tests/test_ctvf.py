@@ -352,9 +352,9 @@ def test_short_taylor_green_run(tmp_path, nx, extra, l1max, umax):
     (100, ("--shifting", "spst"), dict(l1=0.01, l1max=0.08, umax=0.01)),
 ], ids=["ipst-nx50", "spst-nx100"])
 def test_taylor_green_re100_to_t2(tmp_path, nx, extra, bounds):
-    """docs/ctvf.md: Re 100, t = 2 (measured: IPST nx 50 L1 0.0095, max 0.070,
+    """docs/ctvf.md: Re 100, t = 2, plain lattice (measured: IPST nx 50 L1 0.0095, max 0.070,
     max|u| +1.04 %; SPST nx 100 L1 0.0046, max 0.069, max|u| +0.14 %)."""
-    res, _ = run_tg(tmp_path, "--scheme", "ctvf", *extra, "--no-openmp", nx=nx, tf=2.0)
+    res, _ = run_tg(tmp_path, "--scheme", "ctvf", *extra, "--no-openmp", "--perturb", "0", nx=nx, tf=2.0)
     assert res["l1_error"] <= bounds["l1"] and res["l1_error_max"] <= bounds["l1max"], res
     assert abs(res["max_u_rel_error"]) <= bounds["umax"], res
 
@@ -392,10 +392,10 @@ def test_ctvf_max_u_within_three_percent_of_the_exact_decay(tmp_path):
 
 @pytest.mark.slow
 def test_ctvf_re1000_l1_falls_with_resolution(tmp_path, capsys):
-    """Adepu & Ramachandran (2021) Fig. 9: Re 1000, SPST, t = 2 (measured, docs/ctvf.md:
-    0.0929 at 50 x 50, 0.0226 at 100 x 100, order 2.04)."""
-    e50 = tg_whole_run(tmp_path, "ctvf", 1000, nx=50)["l1_error"]
-    e100 = tg_whole_run(tmp_path / "100", "ctvf", 1000, nx=100)["l1_error"]
+    """Adepu & Ramachandran (2021) Fig. 9: Re 1000, SPST, t = 2, plain lattice (measured,
+    docs/ctvf.md: 0.0929 at 50 x 50, 0.0226 at 100 x 100, order 2.04)."""
+    e50 = tg_whole_run(tmp_path, "ctvf", 1000, "--perturb", "0", nx=50)["l1_error"]
+    e100 = tg_whole_run(tmp_path / "100", "ctvf", 1000, "--perturb", "0", nx=100)["l1_error"]
     with capsys.disabled():
         print(f"\nTaylor-Green Re 1000 CTVF + SPST, t = 2: L1 {e50:.4f} (50), {e100:.4f} (100), "
               f"order {np.log(e50 / e100) / np.log(2):.2f}")
@@ -407,7 +407,8 @@ def test_ctvf_re1000_l1_falls_with_resolution(tmp_path, capsys):
                    "ends lower (L1 0.0113 against 0.0226 with them); the -u div(delta) term raises it",
                    strict=False)
 def test_ctvf_corrections_lower_the_l1_error(tmp_path):
-    """Adepu & Ramachandran (2021) Fig. 10 (at 150 x 150 there; 100 x 100 here)."""
-    with_ = tg_whole_run(tmp_path, "ctvf", 1000, nx=100)["l1_error"]
-    without = tg_whole_run(tmp_path, "ctvf", 1000, "--no-corrections", nx=100)["l1_error"]
+    """Adepu & Ramachandran (2021) Fig. 10 (at 150 x 150 there; 100 x 100 here; plain lattice,
+    as measured)."""
+    with_ = tg_whole_run(tmp_path, "ctvf", 1000, "--perturb", "0", nx=100)["l1_error"]
+    without = tg_whole_run(tmp_path, "ctvf", 1000, "--no-corrections", "--perturb", "0", nx=100)["l1_error"]
     assert with_ < without
