@@ -28,7 +28,6 @@ end, and the trajectory of the material points A (outer left) and B (outer top) 
 left ring.  The energy includes the contact springs' k (d0 - r)^2 / 2.  Plots: energy.png,
 points.png (A and B against t), rings.png (the final state coloured by p).
 """
-import math
 import os
 
 import numpy as np
@@ -42,13 +41,12 @@ from sphgen.tools.plots import particle_panels
 from sphgen.tools.probes import MaterialPoints
 
 from ..equations.contact import contact_energy
-from ..equations.shifting import SHIFTINGS
 from ..schemes.ctvf import SOLID_CORRECTIONS, CTVFSolidScheme, elastic_constants
 from ..schemes.gtvf import GTVFSolidScheme
+from ._solid_options import add_solid_scheme_options, check_solid_scheme_options
 
 E, RHO0 = 1.0e7, 1200.0
 R_IN, R_OUT, CENTRE = 0.03, 0.04, 0.041
-SCHEMES = ("ctvf", "gtvf")
 LATTICES = ("vertex", "centred")
 
 
@@ -83,35 +81,25 @@ class Rings(Application):
     error_key = None
 
     def add_user_options(self, group):
-        group.add_argument("--scheme", choices=SCHEMES, default="ctvf", help="CTVF or GTVF (default ctvf)")
-        group.add_argument("--shifting", choices=SHIFTINGS, default=None,
-                           help="homogenisation (default: spst for ctvf, gtvf for gtvf)")
-        group.add_argument("--no-corrections", action="store_true", help="ctvf: no correction terms")
+        add_solid_scheme_options(group)
         group.add_argument("--poisson", type=float, default=0.3975, help="Poisson ratio (paper: 0.3975, 0.47)")
         group.add_argument("--v0", type=float, default=0.059, help="speed of each ring / c0 (default %(default)s)")
         group.add_argument("--dx", type=float, default=0.001, help="particle spacing (paper: 0.001 m)")
         group.add_argument("--hdx", type=float, default=1.0, help="h / dx (default %(default)s)")
         group.add_argument("--lattice", choices=LATTICES, default="vertex",
                            help="vertex: points centre + i dx (PySPH's rings); centred: cell centres")
-        group.add_argument("--alpha", type=float, default=1.0, help="artificial viscosity (paper: 1)")
         group.add_argument("--record-every", type=float, default=1e-4, help="time between samples (s)")
         group.add_argument("--one-body", action="store_true",
                            help="both rings in one array (the contact carries tension; PySPH's rings)")
 
     def consume_user_options(self, o):
-        for name in ("dx", "hdx", "v0", "record_every"):
-            v = getattr(o, name)
-            if not (math.isfinite(v) and v > 0):
-                raise InputError(f"--{name.replace('_', '-')} must be a positive number, got {v}")
+        self.shifting = check_solid_scheme_options(o, ("dx", "hdx", "v0", "record_every"))
         if not 0 < o.poisson < 0.5:
             raise InputError(f"--poisson must be in (0, 0.5), got {o.poisson}")
         if o.dx > 0.005:
             raise InputError(f"--dx {o.dx} leaves fewer than 2 particles across the rings")
-        if o.no_corrections and o.scheme != "ctvf":
-            raise InputError("--no-corrections applies to --scheme ctvf only")
         self.c0, self.G = elastic_constants(E, o.poisson, RHO0)
         self.K = RHO0 * self.c0 ** 2
-        self.shifting = o.shifting or ("spst" if o.scheme == "ctvf" else "gtvf")
         self._next_record = 0.0
 
     def _array(self, name, x, y, sign):

@@ -16,7 +16,6 @@ estimate E V t / ((1 - nu^2) H) of a bar with free sides (the published curves o
 Cleary are not shipped: docs/ctvf.md).  Plots: von_mises.png, specimen.png (the final
 state coloured by the von Mises stress).
 """
-import math
 import os
 
 import numpy as np
@@ -29,13 +28,12 @@ from sphgen.particles import ParticleArray
 from sphgen.tools.plots import particle_panels
 from sphgen.tools.probes import MaterialPoints
 
-from ..equations.shifting import SHIFTINGS
 from ..schemes.ctvf import SOLID_CORRECTIONS, CTVFSolidScheme, elastic_constants
 from ..schemes.gtvf import GTVFSolidScheme
+from ._solid_options import add_solid_scheme_options, check_solid_scheme_options
 
 E, POISSON, RHO0 = 7.5e9, 0.398, 2300.0
 WIDTH, HEIGHT, PISTON_SPEED = 0.082, 0.14, 1.5e-3
-SCHEMES = ("ctvf", "gtvf")
 
 
 def von_mises(p, sd):
@@ -60,28 +58,18 @@ class UniaxialCompression(Application):
     error_key = None
 
     def add_user_options(self, group):
-        group.add_argument("--scheme", choices=SCHEMES, default="ctvf", help="CTVF or GTVF (default ctvf)")
-        group.add_argument("--shifting", choices=SHIFTINGS, default=None,
-                           help="homogenisation (default: spst for ctvf, gtvf for gtvf)")
-        group.add_argument("--no-corrections", action="store_true", help="ctvf: no correction terms")
+        add_solid_scheme_options(group)
         group.add_argument("--dx", type=float, default=0.002, help="particle spacing (paper: 0.5, 1, 2 mm)")
         group.add_argument("--layers", type=int, default=3, help="rows of the base and of the piston")
-        group.add_argument("--alpha", type=float, default=1.0, help="artificial viscosity (paper: 1)")
         group.add_argument("--record-every", type=float, default=2e-5, help="time between samples (s)")
 
     def consume_user_options(self, o):
-        for name in ("dx", "record_every"):
-            v = getattr(o, name)
-            if not (math.isfinite(v) and v > 0):
-                raise InputError(f"--{name.replace('_', '-')} must be a positive number, got {v}")
+        self.shifting = check_solid_scheme_options(o, ("dx", "record_every"))
         if o.dx > WIDTH / 8:
             raise InputError(f"--dx {o.dx} leaves fewer than 8 particles across the specimen")
         if o.layers < 1:
             raise InputError(f"--layers must be at least 1, got {o.layers}")
-        if o.no_corrections and o.scheme != "ctvf":
-            raise InputError("--no-corrections applies to --scheme ctvf only")
         self.c0, self.G = elastic_constants(E, POISSON, RHO0)
-        self.shifting = o.shifting or ("spst" if o.scheme == "ctvf" else "gtvf")
         self._next_record = 0.0
 
     def create_particles(self):
