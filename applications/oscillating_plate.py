@@ -142,20 +142,21 @@ class OscillatingPlate(Application):
 
     def create_particles(self):
         o, dx = self.options, self.dx
-        x, y = rectangle(-o.clamp_layers * dx, o.length, -0.5 * o.height, 0.5 * o.height, dx)
-        if o.perturb > 0:
+        x0, y0 = rectangle(-o.clamp_layers * dx, o.length, -0.5 * o.height, 0.5 * o.height, dx)
+        x, y = x0, y0
+        if o.perturb > 0:      # the plate only; clamp, tip and bonds from the lattice
             rng = np.random.default_rng(o.seed)
-            x = x + o.perturb * dx * rng.uniform(-1, 1, x.size) * (x > 0)
-            y = y + o.perturb * dx * rng.uniform(-1, 1, y.size) * (x > 0)
+            x = x0 + o.perturb * dx * rng.uniform(-1, 1, x0.size) * (x0 > 0)
+            y = y0 + o.perturb * dx * rng.uniform(-1, 1, y0.size) * (x0 > 0)
         v = np.where(x > 0, o.vf * self.c0 * mode_shape(np.maximum(x, 0.0), o.length)
                      / mode_shape(o.length, o.length), 0.0)
         n = x.size
         plate = ParticleArray("plate", x=x, y=y, v=v, rho=np.full(n, RHO0), m=np.full(n, RHO0 * dx * dx),
                               h=np.full(n, dx))
-        self.clamp_gids = np.flatnonzero(x < 0)
-        xt = x.max()
-        self.tip = MaterialPoints("plate", gids=np.flatnonzero((x == xt) & (np.abs(y) < 0.6 * dx)))
-        i, j, _ = pairs_within((x, y), (x, y), 1.01 * dx)
+        self.clamp_gids = np.flatnonzero(x0 < 0)
+        xt = x0.max()
+        self.tip = MaterialPoints("plate", gids=np.flatnonzero((x0 == xt) & (np.abs(y0) < 0.6 * dx)))
+        i, j, _ = pairs_within((x0, y0), (x0, y0), 1.01 * dx)
         keep = i < j
         self.bonds = np.column_stack([i[keep], j[keep]])        # gids = initial indices
         self.sparse0 = sparse_particles(x, y, dx)

@@ -12,14 +12,22 @@ keeps 8 of the points that lie exactly on the outer circles by round-off, the in
 test here none) or on the
 cell-centred lattice (``--lattice centred``, :func:`sphgen.geometry.annulus`).
 
+Each ring is a body of its own (arrays ``left`` and ``right``): its SPH sums run over its
+own particles, and the rings touch only through a contact force that pushes and never
+pulls (:class:`~sphgen.equations.contact.ContactForce`, the scheme's ``contact``), so
+they part freely after the rebound.  ``--one-body`` puts both rings in one array whose
+sums run over both (PySPH's ``solid_mech.rings``): the contact then carries tension and
+the rings stay joined.
+
 ``results.json``: whether the run reached the end, the largest speed over the run (a
 blow-up shows as a speed of order c0), the energies (kinetic, elastic: s':s'/(4G) +
 p^2/(2K) per unit volume) at the start and the end, the x velocity of each ring's centre
-of mass at the end (reversed: the rings bounced), and the trajectory of the material
-points A (outer left) and B (outer top) of the left ring.  Plots: energy.png,
+of mass at the end (reversed: the rings bounced), the gap between the rings (smallest
+distance between a particle of one and one of the other, in dx) against time and at the
+end, and the trajectory of the material points A (outer left) and B (outer top) of the
+left ring.  The energy includes the contact springs' k (d0 - r)^2 / 2.  Plots: energy.png,
 points.png (A and B against t), rings.png (the final state coloured by p).
 """
-import math
 import os
 
 import numpy as np
@@ -32,13 +40,13 @@ from sphgen.particles import ParticleArray
 from sphgen.tools.plots import particle_panels
 from sphgen.tools.probes import MaterialPoints
 
-from ..equations.shifting import SHIFTINGS
+from ..equations.contact import contact_energy
 from ..schemes.ctvf import SOLID_CORRECTIONS, CTVFSolidScheme, elastic_constants
 from ..schemes.gtvf import GTVFSolidScheme
+from ._solid_options import add_solid_scheme_options, check_solid_scheme_options
 
 E, RHO0 = 1.0e7, 1200.0
 R_IN, R_OUT, CENTRE = 0.03, 0.04, 0.041
-SCHEMES = ("ctvf", "gtvf")
 LATTICES = ("vertex", "centred")
 
 
@@ -67,88 +75,112 @@ class Rings(Application):
     tf = 0.016
     pfreq = 1000
     dim = 2
-    history_columns = ("t", "kinetic", "elastic", "max_speed", "xA", "yA", "xB", "yB", "u_left", "u_right")
+    history_columns = ("t", "kinetic", "elastic", "max_speed", "xA", "yA", "xB", "yB", "u_left", "u_right",
+                       "contact", "gap")
+    bodies = ("left", "right")
     error_key = None
 
     def add_user_options(self, group):
-        group.add_argument("--scheme", choices=SCHEMES, default="ctvf", help="CTVF or GTVF (default ctvf)")
-        group.add_argument("--shifting", choices=SHIFTINGS, default=None,
-                           help="homogenisation (default: spst for ctvf, gtvf for gtvf)")
-        group.add_argument("--no-corrections", action="store_true", help="ctvf: no correction terms")
+        add_solid_scheme_options(group)
         group.add_argument("--poisson", type=float, default=0.3975, help="Poisson ratio (paper: 0.3975, 0.47)")
         group.add_argument("--v0", type=float, default=0.059, help="speed of each ring / c0 (default %(default)s)")
         group.add_argument("--dx", type=float, default=0.001, help="particle spacing (paper: 0.001 m)")
         group.add_argument("--hdx", type=float, default=1.0, help="h / dx (default %(default)s)")
         group.add_argument("--lattice", choices=LATTICES, default="vertex",
                            help="vertex: points centre + i dx (PySPH's rings); centred: cell centres")
-        group.add_argument("--alpha", type=float, default=1.0, help="artificial viscosity (paper: 1)")
         group.add_argument("--record-every", type=float, default=1e-4, help="time between samples (s)")
+        group.add_argument("--one-body", action="store_true",
+                           help="both rings in one array (the contact carries tension; PySPH's rings)")
 
     def consume_user_options(self, o):
-        for name in ("dx", "hdx", "v0", "record_every"):
-            v = getattr(o, name)
-            if not (math.isfinite(v) and v > 0):
-                raise InputError(f"--{name.replace('_', '-')} must be a positive number, got {v}")
+        self.shifting = check_solid_scheme_options(o, ("dx", "hdx", "v0", "record_every"))
         if not 0 < o.poisson < 0.5:
             raise InputError(f"--poisson must be in (0, 0.5), got {o.poisson}")
         if o.dx > 0.005:
             raise InputError(f"--dx {o.dx} leaves fewer than 2 particles across the rings")
-        if o.no_corrections and o.scheme != "ctvf":
-            raise InputError("--no-corrections applies to --scheme ctvf only")
         self.c0, self.G = elastic_constants(E, o.poisson, RHO0)
         self.K = RHO0 * self.c0 ** 2
-        self.shifting = o.shifting or ("spst" if o.scheme == "ctvf" else "gtvf")
         self._next_record = 0.0
+
+    def _array(self, name, x, y, sign):
+        o, n = self.options, x.size
+        return ParticleArray(name, x=x, y=y, u=np.full(n, sign * o.v0 * self.c0), rho=np.full(n, RHO0),
+                             m=np.full(n, RHO0 * o.dx * o.dx), h=np.full(n, o.hdx * o.dx))
 
     def create_particles(self):
         o, dx = self.options, self.options.dx
         xl, yl = ring_lattice(-CENTRE, dx, o.lattice)
         xr, yr = ring_lattice(CENTRE, dx, o.lattice)
-        x, y = np.concatenate([xl, xr]), np.concatenate([yl, yr])
-        n = x.size
-        u = np.where(x < 0, 1.0, -1.0) * o.v0 * self.c0
-        pa = ParticleArray("rings", x=x, y=y, u=u, rho=np.full(n, RHO0), m=np.full(n, RHO0 * dx * dx),
-                           h=np.full(n, o.hdx * dx))
-        self.left = np.flatnonzero(x < 0)
-        near = [int(np.argmin((x - px) ** 2 + (y - py) ** 2)) for px, py in ((-CENTRE - R_OUT, 0.0), (-CENTRE, R_OUT))]
-        self.points = MaterialPoints("rings", gids=near)          # A (outer left), B (outer top)
-        return [pa]
+        near = [int(np.argmin((xl - px) ** 2 + (yl - py) ** 2)) for px, py in ((-CENTRE - R_OUT, 0.0), (-CENTRE, R_OUT))]
+        if o.one_body:
+            self.media = ["rings"]
+            self.n_left = xl.size
+            arrays = [self._array("rings", np.concatenate([xl, xr]), np.concatenate([yl, yr]), 1.0)]
+            arrays[0].u[xl.size:] *= -1.0
+        else:
+            self.media = list(self.bodies)
+            arrays = [self._array("left", xl, yl, 1.0), self._array("right", xr, yr, -1.0)]
+        self.points = MaterialPoints(self.media[0], gids=near)     # A (outer left), B (outer top)
+        return arrays
 
     def create_scheme(self):
         o = self.options
-        common = dict(h=o.hdx * o.dx, dx=o.dx, umax=o.v0 * self.c0, shifting=self.shifting, alpha=o.alpha)
+        common = dict(h=o.hdx * o.dx, dx=o.dx, umax=o.v0 * self.c0, shifting=self.shifting, alpha=o.alpha,
+                      contact=not o.one_body)
+        media = ["rings"] if o.one_body else list(self.bodies)
         if o.scheme == "gtvf":
-            return GTVFSolidScheme(["rings"], 2, RHO0, E, o.poisson, **common)
+            return GTVFSolidScheme(media, 2, RHO0, E, o.poisson, **common)
         corrections = () if o.no_corrections else SOLID_CORRECTIONS
-        return CTVFSolidScheme(["rings"], 2, RHO0, E, o.poisson, corrections=corrections, **common)
+        return CTVFSolidScheme(media, 2, RHO0, E, o.poisson, corrections=corrections, **common)
 
     def history_meta(self):
         o = self.options
         return {"dx": o.dx, "scheme": o.scheme, "shifting": self.shifting, "poisson": o.poisson, "v0": o.v0,
-                "c0": self.c0, "G": self.G, "K": self.K, "n_particles": int(self.scene.by_name["rings"].n),
-                "lattice": o.lattice, "corrections": not o.no_corrections}
+                "c0": self.c0, "G": self.G, "K": self.K,
+                "n_particles": int(sum(self.scene.by_name[m].n for m in self.media)),
+                "lattice": o.lattice, "corrections": not o.no_corrections, "contact": not o.one_body,
+                "contact_stiffness": self.contact_k()}
 
-    def row(self, pa, t):
-        kinetic, elastic = energies(pa, self.G, self.K)
-        (xa, ya), (xb, yb) = self.points.positions({"rings": pa})
-        left = np.isin(pa.gid, self.left)
-        ul = float(np.sum(pa.m[left] * pa.u[left]) / np.sum(pa.m[left]))
-        ur = float(np.sum(pa.m[~left] * pa.u[~left]) / np.sum(pa.m[~left]))
-        return [t, kinetic, elastic, float(np.sqrt((pa.u ** 2 + pa.v ** 2).max())), float(xa), float(ya),
-                float(xb), float(yb), ul, ur]
+    def contact_k(self):
+        return None if self.options.one_body else self.scheme.contact_stiffness()
+
+    def bodies_of(self, arrays):
+        """[(x, y, u, v, m) of the left ring, ... of the right ring] from the arrays."""
+        props = ("x", "y", "u", "v", "m")
+        if not self.options.one_body:
+            return [tuple(getattr(arrays[b], p) for p in props) for b in self.bodies]
+        pa = arrays["rings"]
+        left = pa.gid < self.n_left
+        return [tuple(getattr(pa, p)[sel] for p in props) for sel in (left, ~left)]
+
+    def row(self, arrays, t):
+        kinetic = elastic = 0.0
+        for m in self.media:
+            k, e = energies(arrays[m], self.G, self.K)
+            kinetic, elastic = kinetic + k, elastic + e
+        (xa, ya), (xb, yb) = self.points.positions(arrays)
+        (xl, yl, ul, vl, ml), (xr, yr, ur, vr, mr) = self.bodies_of(arrays)
+        k = self.contact_k()
+        spring, gap = contact_energy(np.column_stack([xl, yl]), np.column_stack([xr, yr]), k or 0.0,
+                                     self.options.dx)
+        vmax = max(float(np.sqrt((arrays[m].u ** 2 + arrays[m].v ** 2).max())) for m in self.media)
+        return [t, kinetic, elastic, vmax, float(xa), float(ya), float(xb), float(yb),
+                float(np.sum(ml * ul) / np.sum(ml)), float(np.sum(mr * ur) / np.sum(mr)), spring,
+                gap / self.options.dx]
 
     def post_step(self, solver):
-        pa = self.scene.by_name["rings"]
+        arrays = self.scene.by_name
         if not self.history:
-            self.history.append(self.row(pa, 0.0))
+            self.history.append(self.row(arrays, 0.0))
         if solver.t >= self._next_record - 0.5 * solver.dt or solver.t >= solver.tf - 0.5 * solver.dt:
-            self.history.append(self.row(pa, solver.t))
+            self.history.append(self.row(arrays, solver.t))
             self._next_record = solver.t + self.options.record_every
 
     def post_process(self, outdir):
         hist, rows = io.read_history(outdir)
-        t, ek, ee, vmax = rows[:, 0], rows[:, 1], rows[:, 2], rows[:, 3]
-        total = ek + ee
+        t, ek, ee, vmax, ec, gap = rows[:, 0], rows[:, 1], rows[:, 2], rows[:, 3], rows[:, 10], rows[:, 11]
+        total = ek + ee + ec
+        touching = np.flatnonzero(gap < 1.0)
         results = {
             "t": float(t[-1]), "reached_end": bool(t[-1] >= self.options.tf * (1 - 1e-6)),
             "scheme": hist["scheme"], "shifting": hist["shifting"], "poisson": hist["poisson"],
@@ -156,6 +188,11 @@ class Rings(Application):
             "max_speed_over_c0": float(vmax.max() / hist["c0"]),
             "energy_initial": float(total[0]), "energy_final": float(total[-1]),
             "energy_final_over_initial": float(total[-1] / total[0]),
+            "energy_max_over_initial": float(total.max() / total[0]),
+            "contact": hist["contact"], "gap_final_over_dx": float(gap[-1]), "gap_min_over_dx": float(gap.min()),
+            "contact_start": float(t[touching[0]]) if touching.size else None,
+            "contact_end": float(t[touching[-1]]) if touching.size else None,
+            "separated": bool(touching.size and gap[-1] > 1.0),
             "kinetic_min_over_initial": float(ek.min() / ek[0]),
             "elastic_max_over_initial": float(ee.max() / total[0]),
             "u_left_final": float(rows[-1, 8]), "u_right_final": float(rows[-1, 9]),
@@ -166,7 +203,8 @@ class Rings(Application):
         self.plot(outdir, rows, hist)
         print(f"rings: {hist['scheme']}+{hist['shifting']} nu={hist['poisson']} n={hist['n_particles']} t={t[-1]:.4g}  "
               f"E_end/E_0 {results['energy_final_over_initial']:.3f}  max|u|/c0 {results['max_speed_over_c0']:.3f}  "
-              f"u_cm left/right {results['u_left_final']:.3g}/{results['u_right_final']:.3g}\n"
+              f"u_cm left/right {results['u_left_final']:.3g}/{results['u_right_final']:.3g}  "
+              f"gap at the end {results['gap_final_over_dx']:.3g} dx\n"
               f"results: {os.path.join(outdir, 'results.json')}")
         return results
 
@@ -175,11 +213,11 @@ class Rings(Application):
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
         t = rows[:, 0] * 1e3
-        e0 = rows[0, 1] + rows[0, 2]
+        e0 = rows[0, 1] + rows[0, 2] + rows[0, 10]
         fig, ax = plt.subplots(figsize=(6, 4))
-        for k, name in ((1, "kinetic"), (2, "elastic")):
+        for k, name in ((1, "kinetic"), (2, "elastic"), (10, "contact")):
             ax.plot(t, rows[:, k] / e0, label=name)
-        ax.plot(t, (rows[:, 1] + rows[:, 2]) / e0, "k-", label="total")
+        ax.plot(t, (rows[:, 1] + rows[:, 2] + rows[:, 10]) / e0, "k-", label="total")
         ax.set_xlabel("t [ms]")
         ax.set_ylabel("E / E(0)")
         ax.set_title(f"{hist['scheme'].upper()} + {hist['shifting'].upper()}, nu = {hist['poisson']}", fontsize=9)
@@ -197,7 +235,16 @@ class Rings(Application):
         fig.tight_layout()
         fig.savefig(os.path.join(outdir, "points.png"), dpi=100)
         plt.close(fig)
+        fig, ax = plt.subplots(figsize=(6, 4))
+        ax.plot(t, rows[:, 11])
+        ax.axhline(1.0, color="k", lw=0.5)
+        ax.set_xlabel("t [ms]")
+        ax.set_ylabel("gap between the rings / dx")
+        fig.tight_layout()
+        fig.savefig(os.path.join(outdir, "gap.png"), dpi=100)
+        plt.close(fig)
         if self.scene is not None:
-            pa = self.scene.by_name["rings"]
+            arrays = [self.scene.by_name[m] for m in self.media]
+            x, y, p = (np.concatenate([getattr(pa, c) for pa in arrays]) for c in "xyp")
             particle_panels(os.path.join(outdir, "rings.png"),
-                            [(f"t = {rows[-1, 0] * 1e3:.3g} ms", pa.x, pa.y, pa.p)], size=(8.0, 4.0), marker=1)
+                            [(f"t = {rows[-1, 0] * 1e3:.3g} ms", x, y, p)], size=(8.0, 4.0), marker=1)

@@ -30,6 +30,7 @@ from sphgen.kernels import get_kernel
 from sphgen.scheme import Bound, Scheme
 
 from ..equations.basic import SummationDensity, Vorticity2D
+from ..equations.contact import ContactForce
 from ..equations.ctvf import (ContinuityTransportCorrection, EDACTransportCorrection,
                               MomentumTransportDivergence)
 from ..equations.edac import EDACPressureRate
@@ -215,6 +216,14 @@ class TransportVelocityScheme(Scheme):
                                             moving=w in self.moving_walls, dim=self.dim) for w in self.walls]
         return eqs
 
+    def _shift_groups(self):
+        """The homogenisation's groups after the momentum group (IPST), each medium with its
+        own sources (one set of groups when every medium sees the same neighbours)."""
+        sources = [self._sources(d) for d in self.fluids]
+        if all(s == sources[0] for s in sources):
+            return self.shift.groups(self.fluids, sources[0])
+        return [g for d, s in zip(self.fluids, sources) for g in self.shift.groups([d], s)]
+
     def _wall_groups(self):
         """Wall pressure (eq. 52) and density (linear equation of state), the no-slip ghost
         velocity (eq. 50) and the free-slip ghost velocities (eqs. 46-49); [] without walls."""
@@ -351,9 +360,8 @@ class CTVFScheme(TransportVelocityScheme):
         return Group(eqs)
 
     def get_equations(self):
-        src = self._sources(self.fluids[0])
         second = (self._density_groups() + self._wall_groups() + self._surface_groups()
-                  + [self._momentum_group()] + self.shift.groups(self.fluids, src))
+                  + [self._momentum_group()] + self._shift_groups())
         first = self._wall_groups() + [self._rate_group()] + self._surface_pressure_groups()
         return [first, second + self._surface_filter_groups()]
 
@@ -376,13 +384,17 @@ class ElasticSolids:
     the momentum group is eq. 30 (pressure, deviatoric stress, Monaghan artificial
     viscosity with beta = 0, body force, homogenisation); the drift evolves ``sd``
     (eq. 58); ``clamped`` ({array: gids}) particles are held at u = u~ = 0 by the
-    integrator after every stage; ``yield_stress`` Y0 (if given) limits the updated
-    stress to the von Mises surface (section 4.7).  Mix in before the scheme class."""
+    integrator after every stage, ``driven`` ({array: (gids, velocity)}) particles at that
+    constant velocity (u = u~: they move with it, a piston); ``yield_stress`` Y0 (if given) limits the updated
+    stress to the von Mises surface (section 4.7).  ``contact``: each medium is a body of
+    its own (every SPH sum over that medium alone) and the bodies touch only through
+    :class:`~sphgen.equations.contact.ContactForce` (push, no tension; d0 = dx, k =
+    rho0 c0^2 dx^(dim-2), docs/ctvf.md).  Mix in before the scheme class."""
 
     transport_gradient = False
     output_props = ("x", "y", "z", "u", "v", "w", "p", "rho", "m", "h", "sd")
 
-    def _init_solid(self, G, clamped, jaumann_correction, yield_stress=None):
+    def _init_solid(self, G, clamped, jaumann_correction, yield_stress=None, contact=False, driven=None):
         if self.walls:
             raise ValueError(f"{type(self).__name__}: wall arrays for solids (stress extrapolation, eq. 53) "
                              "are not implemented; hold boundary particles with clamped={array: gids}")
@@ -397,12 +409,40 @@ class ElasticSolids:
         if yield_stress is not None and not yield_stress > 0:
             raise ValueError(f"{type(self).__name__}: yield_stress={yield_stress!r} must be > 0")
         self.yield_stress = yield_stress
+        if contact and len(self.fluids) < 2:
+            raise ValueError(f"{type(self).__name__}: contact needs at least two bodies (arrays), got {self.fluids}")
+        self.contact = bool(contact)
+        self.driven = {a: (list(g), tuple(float(c) for c in vel)) for a, (g, vel) in dict(driven or {}).items()}
+        bad = sorted(set(self.driven) - set(self.fluids))
+        if bad:
+            raise ValueError(f"{type(self).__name__}: driven array {bad[0]!r} is not among {self.fluids}")
+        if any(len(vel) != self.dim for _, vel in self.driven.values()):
+            raise ValueError(f"{type(self).__name__}: driven velocities need {self.dim} components")
 
     def parameters(self):
         out = super().parameters()
         out.update(G=self.G, transport_gradient=self.transport_gradient,
-                   jaumann_correction=self.jaumann_correction, yield_stress=self.yield_stress)
+                   jaumann_correction=self.jaumann_correction, yield_stress=self.yield_stress,
+                   contact=self.contact)
         return out
+
+    def contact_stiffness(self):
+        """k = rho0 c0^2 dx^(dim-2): a contact overlap of delta across one particle spacing
+        is a strain delta/dx under the bulk modulus rho0 c0^2, carried by one pair per
+        dx^(dim-1) of contact area."""
+        return self.rho0 * self.c0 ** 2 * self.dx ** (self.dim - 2)
+
+    @property
+    def neighbour_exempt(self):
+        """Pairs of bodies whose neighbour count grows from nothing at contact: not a
+        sign of clumping (the solver's guard skips them)."""
+        return [(d, s) for d in self.fluids for s in self.fluids if self.contact and d != s]
+
+    def _sources(self, dest):
+        """With ``contact`` a body sees only itself (and the walls)."""
+        if self.contact:
+            return [dest] + self.walls
+        return super()._sources(dest)
 
     def setup_properties(self, arrays):
         super().setup_properties(arrays)
@@ -429,6 +469,9 @@ class ElasticSolids:
             src = self._sources(d)
             eqs += [PressureGradient(d, src, bql=False), DeviatoricStressForce(d, src),
                     ArtificialViscosity(d, src, alpha=self.alpha, c0=self.c0)]
+            if self.contact:
+                eqs.append(ContactForce(d, [b for b in self.fluids if b != d], k=self.contact_stiffness(),
+                                        d0=self.dx))
             eqs += self._body_force(d) + self.shift.momentum_equations(d, src)
         return Group(eqs)
 
@@ -445,6 +488,8 @@ class ElasticSolids:
         held = {p: 0.0 for vel in ("u", "v", "w")[:self.dim] for p in (vel, vel + "hat")}
         for array, gids in self.clamped.items():
             integrator.clamp(array, gids, **held)
+        for array, (gids, vel) in self.driven.items():
+            integrator.clamp(array, gids, **{p: c for v, c in zip(("u", "v", "w"), vel) for p in (v, v + "hat")})
         return integrator
 
     def stability_bounds(self, dt):
@@ -463,18 +508,21 @@ class CTVFSolidScheme(ElasticSolids, CTVFScheme):
     artificial viscosity ``alpha`` (paper: 1), SPST (default) or IPST, kick-drift-kick,
     time step eq. 62 (``umax`` is the largest expected speed).  ``corrections``: subset of
     :data:`SOLID_CORRECTIONS`.  ``free_surface`` (default on): the surface treatment of
-    sections 3.4-3.5 as for fluids.  ``clamped``: {array: gids} held fixed.
+    sections 3.4-3.5 as for fluids.  ``clamped``: {array: gids} held fixed; ``driven``:
+    {array: (gids, velocity)} moved at a constant velocity.
     ``edac_damping``: 'paper' (default) is the printed eq. 26, whose damping term carries
     an extra 1/rho against the Laplacian (nu_edac / rho0 here: rho stays within 1% of
     rho0); 'consistent' is the fluid scheme's form.  For rho0 = 1000 the consistent
     damping diffuses the bending pressure across a plate within a fraction of a period
     and makes it far too soft (docs/ctvf.md).  ``yield_stress``: Y0 of the elastic,
-    perfectly plastic limiter (section 4.7; None: elastic).
+    perfectly plastic limiter (section 4.7; None: elastic).  ``contact``: the arrays are
+    separate bodies that touch through a contact force without tension
+    (:class:`ElasticSolids`).
     """
 
     def __init__(self, solids, dim, rho0, E, poisson, h, dx, umax=1.0, shifting="spst", alpha=1.0,
                  corrections=SOLID_CORRECTIONS, clamped=None, free_surface=True, edac_damping="paper",
-                 yield_stress=None, **kw):
+                 yield_stress=None, contact=False, driven=None, **kw):
         if edac_damping not in ("paper", "consistent"):
             raise ValueError(f"edac_damping must be 'paper' or 'consistent', got {edac_damping!r}")
         self.edac_damping = edac_damping
@@ -487,7 +535,7 @@ class CTVFSolidScheme(ElasticSolids, CTVFScheme):
         super().__init__(solids, dim, rho0, c0, 0.0, h, dx, umax=umax, shifting=shifting,
                          corrections=fluid_corrections, density="continuity", alpha=alpha,
                          free_surface=free_surface and shifting != "ipst", **kw)
-        self._init_solid(G, clamped or {}, "jaumann" in corrections, yield_stress)
+        self._init_solid(G, clamped or {}, "jaumann" in corrections, yield_stress, contact, driven)
 
     def nu_edac(self):
         """Eq. 24, divided by rho0 for the printed form of eq. 26 (``edac_damping='paper'``)."""

@@ -88,9 +88,8 @@ class GTVFScheme(TransportVelocityScheme):
         return Group(eqs)
 
     def get_equations(self):
-        src = self._sources(self.fluids[0])
         second = (self._density_groups() + self._wall_groups() + self._surface_groups()
-                  + [self._momentum_group()] + self.shift.groups(self.fluids, src)
+                  + [self._momentum_group()] + self._shift_groups()
                   + self._surface_filter_groups())
         rates = self._rate_groups()
         return [(self._wall_groups() + rates) if rates else [], second]
@@ -103,17 +102,18 @@ class GTVFSolidScheme(ElasticSolids, GTVFScheme):
     homogenisation, p_ref = rho0 c0^2, the bulk modulus) or 'spst'; ``free_surface``
     (default off: the original GTVF has no surface detection) adds the surface treatment
     of the CTVF (sections 3.4-3.5) to the shifting.  Density by continuity with u~ (no
-    summation re-initialisation: a solid with free surfaces), p = c0^2 (rho - rho0)."""
+    summation re-initialisation: a solid with free surfaces), p = c0^2 (rho - rho0).
+    ``contact``: separate bodies touching without tension, as the CTVF solid."""
 
     transport_gradient = True
 
     def __init__(self, solids, dim, rho0, E, poisson, h, dx, umax=1.0, shifting="gtvf", alpha=1.0,
-                 clamped=None, yield_stress=None, **kw):
+                 clamped=None, yield_stress=None, contact=False, driven=None, **kw):
         c0, G = elastic_constants(E, poisson, rho0)
         self.E, self.poisson = E, poisson
         super().__init__(solids, dim, rho0, c0, 0.0, h, dx, umax=umax, shifting=shifting,
                          density="continuity", alpha=alpha, **kw)
-        self._init_solid(G, clamped or {}, False, yield_stress)
+        self._init_solid(G, clamped or {}, False, yield_stress, contact, driven)
 
     def _density_groups(self):
         """p = c0^2 (rho - rho0), rho from the continuity equation."""

@@ -212,6 +212,7 @@ class Application:
                         speed_limit=self.scheme.speed_limit,
                         density_bounds=self.scheme.density_bounds(),
                         metadata={"signature": self.signature, "tf": opts.tf}, **steps)
+        solver.neighbour_exempt = set(getattr(self.scheme, "neighbour_exempt", ()))
         solver.post_step_callbacks.append(self.post_step)
         solver.output_callbacks.append(lambda s, path: self._write_progress())
         if self.diagnostics:

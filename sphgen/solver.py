@@ -32,7 +32,8 @@ class Solver:
     The guard (on by default) checks every step for non-finite values, a particle
     faster than ``speed_limit``, a density outside ``density_bounds`` ({array: (lo,
     hi)}) and a jump of the neighbour count (``neighbour_jump`` times the initial
-    pairs of a list); it stops the run naming step, array, property and particle, and
+    pairs of a list, except the (dest, source) pairs in ``neighbour_exempt``, e.g. bodies
+    that come into contact); it stops the run naming step, array, property and particle, and
     writes the last good state to ``<prefix>_last_good.h5``.
 
     ``metadata`` is written into every output file's solver data (the application
@@ -69,6 +70,7 @@ class Solver:
         self.speed_limit = speed_limit
         self.density_bounds = dict(density_bounds or {})
         self.neighbour_jump = neighbour_jump
+        self.neighbour_exempt = set()
         # particles drift away from their memory neighbours; re-sorting keeps the
         # neighbour loops cache-friendly (carry a 'gid' property to track particles)
         self.sort_every = sort_every
@@ -320,13 +322,13 @@ class Solver:
         return None
 
     def _check_neighbours(self):
-        totals = self.scene.nnps.pair_totals()
+        totals = {k: n for k, n in self.scene.nnps.pair_totals().items() if k not in self.neighbour_exempt}
         if not any(self._pairs0.get(key, 0) and n > self.neighbour_jump * self._pairs0[key]
                    for key, n in totals.items()):
             return None
         for d, s, pairs, i, count in self.scene.nnps.busiest():   # only to say where
             start = self._pairs0.get((d, s))
-            if start and pairs > self.neighbour_jump * start:
+            if start and (d, s) not in self.neighbour_exempt and pairs > self.neighbour_jump * start:
                 return (f"neighbour pairs {d}<-{s} jumped from {start} to {pairs} (particle {i} of "
                         f"{d} has {count} neighbours): particles are clumping")
         return None

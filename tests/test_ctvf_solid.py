@@ -288,15 +288,96 @@ def test_coarse_plate_bends_from_the_clamp(tmp_path):
     assert res["period"] is None            # not a full period yet
 
 
-def test_rings_lattice_matches_pysph_count_and_a_short_run(tmp_path):
+def test_perturbed_plate_keeps_its_tip_clamp_and_bonds(tmp_path):
+    """`sphgen stress` perturbs the plate (0.2 dx): the tip, the clamp and the bonds of the
+    separation measure are those of the lattice, so the tip is followed (it was lost
+    before) and the clamp columns are unmoved."""
+    res, rows, app = run_app("oscillating_plate", tmp_path, "--nh", "4", "--tf", "0.004", "--record-every", "0.002",
+                             "--perturb", "0.2", "--seed", "3")
+    assert np.all(np.isfinite(rows[:, 1])) and rows[-1, 1] > 0 and len(app.tip.gids) == 2
+    pa = app.scene.by_name["plate"]
+    held = np.isin(pa.gid, app.clamp_gids)
+    assert held.sum() == 3 * 4 and np.all(pa.v[held] == 0)
+    ncol = pa.n // 4
+    assert len(app.bonds) == 3 * ncol + 4 * (ncol - 1)        # the lattice's nearest-neighbour pairs
+    assert res["separation"]["pieces_max"] == 1 and not res["separated"]
+
+
+def test_contact_force_pushes_and_never_pulls():
+    """Two bodies: a pair closer than d0 is pushed apart by k (d0 - r) along x_ab, equal and
+    opposite; a pair farther apart (an opening contact) feels nothing: no tension."""
+    from sphgen.equations.contact import ContactForce
+    k, d0, m = 7.0, 1.0, 2.0
+    for r, expect in ((0.8, k * 0.2 / m), (0.999, k * 0.001 / m), (1.2, 0.0), (1.9, 0.0)):
+        arrays = []
+        for name, x in (("a", 0.0), ("b", r)):
+            arrays.append(ParticleArray(name, x=np.array([x]), y=np.array([0.3]), m=np.array([m]),
+                                        h=np.array([1.0]), rho=np.ones(1), au=np.zeros(1), av=np.zeros(1),
+                                        aw=np.zeros(1)))
+        groups = [Group([ContactForce("a", ["b"], k=k, d0=d0), ContactForce("b", ["a"], k=k, d0=d0)])]
+        sc = Scene(arrays, groups, dim=2, kernel=QuinticSpline(2), outputs={"a": ["au"], "b": ["au"]},
+                   backend="python")
+        sc.compute(0, 0.0, 1e-3)
+        a, b = sc.by_name["a"], sc.by_name["b"]
+        assert a.au[0] == pytest.approx(-expect, abs=1e-14) and b.au[0] == pytest.approx(expect, abs=1e-14)
+        assert a.av[0] == 0.0 and b.av[0] == 0.0
+
+
+def test_contact_energy_and_gap_against_all_pairs():
+    from sphgen.equations.contact import contact_energy
+    rng = np.random.default_rng(4)
+    xa = rng.uniform(0, 1, (300, 2))
+    xb = rng.uniform(0, 1, (250, 2)) + [0.9, 0.3]
+    r = np.linalg.norm(xa[:, None] - xb[None], axis=-1)
+    k, d0 = 3.0, 0.05
+    energy, gap = contact_energy(xa, xb, k, d0, block=37)
+    assert gap == pytest.approx(r.min(), rel=1e-14)
+    assert energy == pytest.approx(0.5 * k * np.sum(np.clip(d0 - r, 0, None) ** 2), rel=1e-12) and energy > 0
+    assert contact_energy(xa, xb + [5.0, 0.0], k, d0)[0] == 0.0
+
+
+def test_contact_bodies_see_only_themselves():
+    """With contact each body's sums run over itself; the only cross-body equation is the
+    contact force, and the solver's neighbour guard skips the pairs across bodies."""
+    sch = CTVFSolidScheme(["left", "right"], 2, 1200.0, 1e7, 0.3975, 1e-3, 1e-3, umax=7.0, contact=True)
+    for group in sch.get_equations()[0] + sch.get_equations()[1]:
+        for eq in group.equations:
+            cross = [s for s in (eq.sources or []) if s != eq.dest]
+            assert not cross or type(eq).__name__ == "ContactForce", (type(eq).__name__, eq.dest, eq.sources)
+    assert sorted(sch.neighbour_exempt) == [("left", "right"), ("right", "left")]
+    assert sch.contact_stiffness() == pytest.approx(1200.0 * sch.c0 ** 2)
+    one = CTVFSolidScheme(["rings"], 2, 1200.0, 1e7, 0.3975, 1e-3, 1e-3, umax=7.0)
+    assert one.neighbour_exempt == [] and one.parameters()["contact"] is False
+    with pytest.raises(ValueError, match="two bodies"):
+        CTVFSolidScheme(["rings"], 2, 1200.0, 1e7, 0.3975, 1e-3, 1e-3, contact=True)
+
+
+def test_rings_lattice_matches_pysph_count():
     from sphgen.applications.rings import CENTRE, ring_lattice
     n = sum(ring_lattice(c, 0.0005, "vertex")[0].size for c in (-CENTRE, CENTRE))
     assert n == 17584            # PySPH's solid_mech.rings: 17 592 (8 points on the outer circles by round-off)
-    res, rows, _ = run_app("rings", tmp_path, "--dx", "0.004", "--tf", "0.002", "--record-every", "0.0005")
-    assert res["reached_end"] and res["max_speed_over_c0"] < 0.1
-    total = rows[:, 1] + rows[:, 2]
+
+
+def test_rings_coarse_collide_rebound_and_separate(tmp_path):
+    """Coarse rings (dx = 4 mm, 256 particles) to the paper's end time: they touch, bounce and
+    part (gap above the contact distance dx at the end); the energy (kinetic, elastic,
+    contact springs) never rises above the initial."""
+    res, rows, _ = run_app("rings", tmp_path, "--dx", "0.004", "--record-every", "0.0005")
+    assert res["reached_end"] and res["max_speed_over_c0"] < 0.2 and res["n_particles"] == 256
+    total = rows[:, 1] + rows[:, 2] + rows[:, 10]
     assert np.all(total <= total[0] * (1 + 1e-3))      # artificial viscosity only removes energy
-    assert res["u_left_final"] > 0 > res["u_right_final"]    # still approaching at 2 ms
+    assert rows[:, 10].max() > 0 and res["gap_min_over_dx"] < 1.0     # the contact springs acted
+    assert res["bounced"] and res["separated"] and res["gap_final_over_dx"] > 1.0, res
+
+
+def test_rings_one_body_keeps_pysph_single_array(tmp_path):
+    """--one-body: both rings in one array (PySPH's rings), no contact force, same count."""
+    res, rows, app = run_app("rings", tmp_path, "--dx", "0.004", "--tf", "0.001", "--record-every", "0.0005",
+                             "--one-body")
+    kept = {type(ep.eq).__name__ for ep in app.scene.plan.eqplans if ep.kept}
+    assert "ContactForce" not in kept and list(app.scene.by_name) == ["rings"]
+    assert res["n_particles"] == 256 and res["contact"] is False and np.all(rows[:, 10] == 0.0)
+    assert res["reached_end"] and res["u_left_final"] > 0 > res["u_right_final"]
 
 
 def test_perfect_plasticity_returns_to_the_von_mises_surface():
@@ -352,9 +433,10 @@ def test_plate_gtvf_with_spst_separates(tmp_path):
 
 @pytest.mark.slow
 def test_rings_run_to_the_end(tmp_path):
-    """Paper case (dx = 1 mm, nu = 0.3975, SPST) to t = 0.016 s without blow-up; the rings bounce."""
+    """Paper case (dx = 1 mm, nu = 0.3975, SPST) to t = 0.016 s without blow-up; the rings bounce
+    and part (Fig. 24)."""
     res, rows, _ = run_app("rings", tmp_path)
     assert res["reached_end"] and res["max_speed_over_c0"] < 0.2, res
-    assert res["bounced"], res
-    total = rows[:, 1] + rows[:, 2]
+    assert res["bounced"] and res["separated"] and res["gap_final_over_dx"] > 1.0, res
+    total = rows[:, 1] + rows[:, 2] + rows[:, 10]
     assert np.all(total <= total[0] * (1 + 1e-3))
