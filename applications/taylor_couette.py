@@ -91,14 +91,19 @@ class TaylorCouette(Application):
         group.add_argument("--lattice", choices=("vogel", "rings"), default="vogel",
                            help="particle layout: Vogel's sunflower (the authors' code) or concentric "
                            "circles (default %(default)s)")
-        group.add_argument("--wall-velocity", choices=("rigid", "profile"), default="rigid",
-                           help="rigid: the rings' rigid-body velocities (the paper's text); profile: "
-                           "the exact profile (eq. 28) continued into both rings, as the authors' code "
-                           "does (default %(default)s)")
+        group.add_argument("--wall-velocity", choices=("rigid", "extrapolated", "profile"), default="rigid",
+                           help="rigid: the rings' rigid-body velocities (the paper's text); extrapolated: "
+                           "in L the rings show 2 v_rigid minus the Shepard mean of the fluid's velocity "
+                           "around them (Adami et al. 2012); profile: the exact profile (eq. 28) continued "
+                           "into both rings, as the authors' code does (default %(default)s)")
+        group.add_argument("--layers", type=int, default=None,
+                           help="wall layers of each ring (default ceil(2h/dr) = 3, thesis eq. 1.83)")
         group.add_argument("--cfl", type=float, default=0.05,
                            help="dt = cfl dr / sqrt(c0^2 + 4/3 cs^2) (paper, eq. 26: 0.05)")
 
     def consume_user_options(self, o):
+        if o.layers is not None and o.layers < 1:
+            raise InputError(f"--layers must be at least 1, got {o.layers}")
         if o.nr < 4:
             raise InputError(f"--nr must be at least 4, got {o.nr}")
         for name in ("re", "cfl"):
@@ -112,7 +117,7 @@ class TaylorCouette(Application):
 
     def create_particles(self):
         dr, h = self.dr, HDR * self.dr
-        nl = layers_for_support(2.0, HDR)
+        nl = self.options.layers or layers_for_support(2.0, HDR)
 
         def array(name, x, y):
             n = x.size
@@ -138,7 +143,7 @@ class TaylorCouette(Application):
     def wall_motions(self):
         """{wall: motion}: the outer ring turns at omega; with --wall-velocity profile both
         rings carry the exact profile continued into them (the inner ring stays in place)."""
-        if self.options.wall_velocity == "rigid":
+        if self.options.wall_velocity != "profile":
             return {"outer": rigid_rotation(OMEGA)}
         return {"outer": rigid_rotation(OMEGA, exact_tangential_velocity),
                 "inner": rigid_rotation(0.0, exact_tangential_velocity)}
@@ -147,7 +152,8 @@ class TaylorCouette(Application):
         o = self.options
         return SHTCScheme(["fluid"], 2, rho0=RHO0, c0=C0, cs=CS, h=HDR * self.dr, dr=self.dr, tau=self.tau,
                           model="dprz", cp=o.cp_factor * C0, walls=["inner", "outer"],
-                          moving_walls=sorted(self.wall_motions()), motions=self.wall_motions(), cfl=o.cfl)
+                          moving_walls=sorted(self.wall_motions()), motions=self.wall_motions(), cfl=o.cfl,
+                          wall_velocity="extrapolated" if o.wall_velocity == "extrapolated" else "prescribed")
 
     def post_step(self, solver):
         every = max(1, int(round(0.05 / solver.dt)))
