@@ -44,6 +44,13 @@ def lid_motion(t_ramp=T_RAMP, speed=ULID):
     return motion
 
 
+def add_wall_velocity_option(group):
+    """--wall-velocity: what the walls and the lid show in L (SHTCScheme's wall_velocity)."""
+    group.add_argument("--wall-velocity", choices=("prescribed", "extrapolated"), default="prescribed",
+                       help="the velocity walls and lid show in L: their own (the paper) or 2 v_w minus "
+                       "the Shepard mean of the fluid's around them (Adami et al. 2012) (default %(default)s)")
+
+
 def all_columns(arrays):
     """Positions, h, m, rho and velocities of fluid and walls together (for Shepard probes)."""
     return {k: np.concatenate([get(pa, k) for pa in arrays.values()]) for k in ("x", "y", "h", "m", "rho", "u", "v")}
@@ -76,10 +83,7 @@ class SHTCCavity(Application):
     def add_user_options(self, group):
         group.add_argument("--nx", type=int, default=200, help="particles per side: dr = 1/nx (paper: 200 at Re 100)")
         group.add_argument("--re", type=int, default=100, choices=GHIA_RE, help="Reynolds number (default %(default)s)")
-        group.add_argument("--wall-velocity", choices=("prescribed", "extrapolated"), default="prescribed",
-                           help="the velocity walls and lid show in L: their own (the paper) or 2 v_w minus "
-                           "the Shepard mean of the fluid's around them (Adami et al. 2012) "
-                           "(default %(default)s)")
+        add_wall_velocity_option(group)
         group.add_argument("--cs", type=float, default=CS, help="shear sound speed (paper: 20)")
         add_perturbation_options(group)
 

@@ -10,7 +10,6 @@ rows more than 2h from both walls, its slip at the fixed wall (u_fit(0)/U) and a
 (1 - u_fit(1)/U), the slip lengths (slip / slope), and the largest deviation of the row means
 from U y.  The steady profile does not depend on nu, so nu = 1 (--nu) reaches it by t = 1.
 """
-import math
 import os
 
 import numpy as np
@@ -23,7 +22,8 @@ from sphgen.nnps import Domain
 from sphgen.particles import ParticleArray
 
 from ..schemes.shtc import SHTCScheme, viscosity_factor
-from .shtc_cavity import C0, CS, HDR, RHO0, ULID, filling_lattice, lid_motion
+from .shtc_cavity import C0, CS, HDR, RHO0, ULID, add_wall_velocity_option, filling_lattice, lid_motion
+from .shtc_shear_wave import fluid_relaxation_time
 
 WIDTH = 0.5
 
@@ -45,20 +45,14 @@ class SHTCCouette(Application):
     def add_user_options(self, group):
         group.add_argument("--ny", type=int, default=40, help="particles across: dr = 1/ny (default %(default)s)")
         group.add_argument("--nu", type=float, default=1.0, help="kinematic viscosity (default %(default)s)")
-        group.add_argument("--wall-velocity", choices=("prescribed", "extrapolated"), default="prescribed",
-                           help="the velocity walls and lid show in L: their own (the paper) or 2 v_w minus "
-                           "the Shepard mean of the fluid's around them (Adami et al. 2012) "
-                           "(default %(default)s)")
+        add_wall_velocity_option(group)
         group.add_argument("--cs", type=float, default=CS, help="shear sound speed (default %(default)s, the cavity's)")
 
     def consume_user_options(self, o):
         if o.ny < 8:
             raise InputError(f"--ny must be at least 8, got {o.ny}")
-        for name in ("nu", "cs"):
-            if not (math.isfinite(getattr(o, name)) and getattr(o, name) > 0):
-                raise InputError(f"--{name} must be positive, got {getattr(o, name)}")
         self.dr = 1.0 / o.ny
-        self.tau = 6.0 * o.nu / o.cs ** 2
+        self.tau = fluid_relaxation_time(o)
 
     def create_particles(self):
         dr = self.dr

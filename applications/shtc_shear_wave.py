@@ -26,6 +26,14 @@ RHO0, C0, U0, HDR = 1.0, 20.0, 0.1, 1.5
 K = 2.0 * math.pi
 
 
+def fluid_relaxation_time(o):
+    """tau = 6 nu/cs^2 (Kincl et al. (2023), eq. 29) from the options --nu and --cs, checked."""
+    for name in ("nu", "cs"):
+        if not (math.isfinite(getattr(o, name)) and getattr(o, name) > 0):
+            raise InputError(f"--{name} must be positive, got {getattr(o, name)}")
+    return 6.0 * o.nu / o.cs ** 2
+
+
 def amplitude(y, u, m):
     """Projection 2 sum m u sin(k y) / sum m of u on the wave sin(k y)."""
     return float(2.0 * np.sum(m * u * np.sin(K * y)) / np.sum(m))
@@ -53,11 +61,8 @@ class SHTCShearWave(Application):
     def consume_user_options(self, o):
         if o.nx < 8:
             raise InputError(f"--nx must be at least 8, got {o.nx}")
-        for name in ("nu", "cs"):
-            if not (math.isfinite(getattr(o, name)) and getattr(o, name) > 0):
-                raise InputError(f"--{name} must be positive, got {getattr(o, name)}")
         self.dr = 1.0 / o.nx
-        self.tau = 6.0 * o.nu / o.cs ** 2
+        self.tau = fluid_relaxation_time(o)
 
     def create_particles(self):
         dr = self.dr
