@@ -76,3 +76,14 @@ def test_re100_centrelines_within_005_of_ghia(tmp_path):
     res, _ = run_cavity(tmp_path / "re100", "--nx", "40", "--cs", "10", "--dt", "2e-4", "--tf", "12")
     assert res["viscosity_factor"] == pytest.approx(1.0, abs=1e-3)
     assert res["ghia_error"] < 0.05, res
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(reason="measured 0.059 at nx = 80, t = 12 (0.050-0.092, mean 0.066, over 6 <= t <= 12; "
+                   "0.129 with the paper's walls), docs/shtc.md", strict=False)
+def test_re100_nx80_extrapolated_walls_within_005_of_ghia(tmp_path):
+    """The issue's check at nx = 80 with the walls' and lid's velocity in L extrapolated from the
+    fluid (Adami et al. 2012), dt = tau/3, cs = 10, t = 12."""
+    res, _ = run_cavity(tmp_path / "e80", "--nx", "80", "--cs", "10", "--dt", "2e-4", "--tf", "12",
+                        "--wall-velocity", "extrapolated")
+    assert res["ghia_error"] < 0.05, res
