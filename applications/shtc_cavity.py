@@ -8,7 +8,9 @@ right and bottom walls: ceil(2h/dr) = 3 layers of dummy particles at rest that c
 own state and run the scheme's equations; the lid is the same kind of layer above y = 1,
 made of immobile particles whose prescribed velocity (1, 0), ramped linearly over
 t = 0.4 (the ramp is not stated in the papers; the authors' code ramps linearly over
-0.4), enters only the velocity gradient L.  dt from eq. 26 unless ``--dt`` (paper: 1.5e-5).
+0.4), enters only the velocity gradient L (``--wall-velocity extrapolated``: walls and lid
+show, in L, 2 v_w minus the fluid's Shepard mean around them, Adami et al. 2012; not the
+paper's).  dt from eq. 26 unless ``--dt`` (paper: 1.5e-5).
 
 ``results.json``: u on x = 0.5 and v on y = 0.5 at Ghia's points (Shepard interpolation
 over fluid and walls) at the final time, and the largest deviation from Ghia's values

@@ -6,7 +6,9 @@ fixed and the outer ring turns rigidly counter-clockwise at omega = 1.  Both rin
 dummy walls of ceil(2h/dr) = 3 layers that carry their own rho, lambda, A and T and run the
 scheme's own equations (they enter the fluid's sums and forces); the outer ring's positions
 and velocities are prescribed, x(t) = Rot(omega t) x(0), v = omega (-y, x), at the times of
-the integrator's stages (the half step for L, the full step for the force).  DPRZ with
+the integrator's stages (the half step for L, the full step for the force);
+``--wall-velocity extrapolated`` lets the rings show, in L only, 2 v_rigid minus the fluid's
+Shepard mean around them (Adami et al. 2012; not the paper's text).  DPRZ with
 rho0 = 1, c0 = 20, cs = 40, c_p = 0.01 c0, nu = omega R2 (R2 - R1) / Re (Re = 20: nu = 0.1)
 and tau = 6 nu / cs^2 (eq. 29).  Particles on Vogel's sunflower lattice (area dr^2 each, as in the authors'
 code; ``--lattice rings``: concentric circles), dr = (R2 - R1) / ``--nr`` (paper, Table 1: 30), h = 1.5 dr, dt from eq. 26.

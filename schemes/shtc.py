@@ -22,6 +22,9 @@ and C_lambda.  Walls (dummy particles) carry their own A, rho, lambda and T and 
 same equations (they enter the bodies' sums and forces through T_b and lambda_b); their
 positions and velocities are prescribed (``Integrator.add_motion``), never integrated, and
 their A is updated from their own L.  A lid's prescribed velocity therefore enters only L.
+With ``wall_velocity='extrapolated'`` the walls show, in L only, the ghost velocity 2 v_w minus
+the Shepard mean of the bodies' velocities around them (Adami, Hu & Adams 2012, eqs. 22-23),
+which removes most of the dummy walls' slip (docs/shtc.md).
 """
 import math
 
