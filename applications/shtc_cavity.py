@@ -8,7 +8,9 @@ right and bottom walls: ceil(2h/dr) = 3 layers of dummy particles at rest that c
 own state and run the scheme's equations; the lid is the same kind of layer above y = 1,
 made of immobile particles whose prescribed velocity (1, 0), ramped linearly over
 t = 0.4 (the ramp is not stated in the papers; the authors' code ramps linearly over
-0.4), enters only the velocity gradient L.  dt from eq. 26 unless ``--dt`` (paper: 1.5e-5).
+0.4), enters only the velocity gradient L (``--wall-velocity extrapolated``: walls and lid
+show, in L, 2 v_w minus the fluid's Shepard mean around them, Adami et al. 2012; not the
+paper's).  dt from eq. 26 unless ``--dt`` (paper: 1.5e-5).
 
 ``results.json``: u on x = 0.5 and v on y = 0.5 at Ghia's points (Shepard interpolation
 over fluid and walls) at the final time, and the largest deviation from Ghia's values
@@ -44,20 +46,29 @@ def lid_motion(t_ramp=T_RAMP, speed=ULID):
     return motion
 
 
+def add_wall_velocity_option(group):
+    """--wall-velocity: what the walls and the lid show in L (SHTCScheme's wall_velocity)."""
+    group.add_argument("--wall-velocity", choices=("prescribed", "extrapolated"), default="prescribed",
+                       help="the velocity walls and lid show in L: their own (the paper) or 2 v_w minus "
+                       "the Shepard mean of the fluid's around them (Adami et al. 2012) (default %(default)s)")
+
+
 def all_columns(arrays):
     """Positions, h, m, rho and velocities of fluid and walls together (for Shepard probes)."""
     return {k: np.concatenate([get(pa, k) for pa in arrays.values()]) for k in ("x", "y", "h", "m", "rho", "u", "v")}
 
 
-def filling_lattice(dr, side=1.0):
-    """Isometric lattice that fills (0, side)^2 with whole rows and columns: the paper's spacing
+def filling_lattice(dr, side=1.0, width=None):
+    """Isometric lattice that fills (0, width) x (0, side) (width = side unless given) with whole
+    rows and columns: the paper's spacing
     (4/3)^(1/4) dr and rows (3/4)^(1/4) dr rounded so that round(side/spacing) points and rows
     fit exactly; rows at (j + 1/2) b, points at (i + 1/4) a or (i + 3/4) a in alternate rows.
     So the fluid stands half a row from the lid and the floor at every resolution (the plain
     ``hexagonal_lattice`` of the box left 1.38 dr under the lid at dr = 1/40)."""
     nr = max(int(round(side / (0.75 ** 0.25 * dr))), 1)
-    nc = max(int(round(side / ((4.0 / 3.0) ** 0.25 * dr))), 1)
-    b, a = side / nr, side / nc
+    width = side if width is None else width
+    nc = max(int(round(width / ((4.0 / 3.0) ** 0.25 * dr))), 1)
+    b, a = side / nr, width / nc
     j, i = np.meshgrid(np.arange(nr), np.arange(nc), indexing="ij")
     return ((i + 0.25 + 0.5 * (j % 2)) * a).ravel(), ((j + 0.5) * b).ravel()
 
@@ -74,6 +85,7 @@ class SHTCCavity(Application):
     def add_user_options(self, group):
         group.add_argument("--nx", type=int, default=200, help="particles per side: dr = 1/nx (paper: 200 at Re 100)")
         group.add_argument("--re", type=int, default=100, choices=GHIA_RE, help="Reynolds number (default %(default)s)")
+        add_wall_velocity_option(group)
         group.add_argument("--cs", type=float, default=CS, help="shear sound speed (paper: 20)")
         add_perturbation_options(group)
 
@@ -103,7 +115,8 @@ class SHTCCavity(Application):
     def create_scheme(self):
         return SHTCScheme(["fluid"], 2, rho0=RHO0, c0=C0, cs=self.options.cs, h=HDR * self.dr, dr=self.dr,
                           tau=self.tau, model="dprz", cp=0.0, walls=["wall", "lid"], moving_walls=["lid"],
-                          motions={"lid": lid_motion()})
+                          motions={"lid": lid_motion()},
+                          wall_velocity=self.options.wall_velocity)
 
     def post_step(self, solver):
         every = max(1, int(round(0.1 / solver.dt)))

@@ -6,7 +6,9 @@ fixed and the outer ring turns rigidly counter-clockwise at omega = 1.  Both rin
 dummy walls of ceil(2h/dr) = 3 layers that carry their own rho, lambda, A and T and run the
 scheme's own equations (they enter the fluid's sums and forces); the outer ring's positions
 and velocities are prescribed, x(t) = Rot(omega t) x(0), v = omega (-y, x), at the times of
-the integrator's stages (the half step for L, the full step for the force).  DPRZ with
+the integrator's stages (the half step for L, the full step for the force);
+``--wall-velocity extrapolated`` lets the rings show, in L only, 2 v_rigid minus the fluid's
+Shepard mean around them (Adami et al. 2012; not the paper's text).  DPRZ with
 rho0 = 1, c0 = 20, cs = 40, c_p = 0.01 c0, nu = omega R2 (R2 - R1) / Re (Re = 20: nu = 0.1)
 and tau = 6 nu / cs^2 (eq. 29).  Particles on Vogel's sunflower lattice (area dr^2 each, as in the authors'
 code; ``--lattice rings``: concentric circles), dr = (R2 - R1) / ``--nr`` (paper, Table 1: 30), h = 1.5 dr, dt from eq. 26.
@@ -91,14 +93,19 @@ class TaylorCouette(Application):
         group.add_argument("--lattice", choices=("vogel", "rings"), default="vogel",
                            help="particle layout: Vogel's sunflower (the authors' code) or concentric "
                            "circles (default %(default)s)")
-        group.add_argument("--wall-velocity", choices=("rigid", "profile"), default="rigid",
-                           help="rigid: the rings' rigid-body velocities (the paper's text); profile: "
-                           "the exact profile (eq. 28) continued into both rings, as the authors' code "
-                           "does (default %(default)s)")
+        group.add_argument("--wall-velocity", choices=("rigid", "extrapolated", "profile"), default="rigid",
+                           help="rigid: the rings' rigid-body velocities (the paper's text); extrapolated: "
+                           "in L the rings show 2 v_rigid minus the Shepard mean of the fluid's velocity "
+                           "around them (Adami et al. 2012); profile: the exact profile (eq. 28) continued "
+                           "into both rings, as the authors' code does (default %(default)s)")
+        group.add_argument("--layers", type=int, default=None,
+                           help="wall layers of each ring (default ceil(2h/dr) = 3, thesis eq. 1.83)")
         group.add_argument("--cfl", type=float, default=0.05,
                            help="dt = cfl dr / sqrt(c0^2 + 4/3 cs^2) (paper, eq. 26: 0.05)")
 
     def consume_user_options(self, o):
+        if o.layers is not None and o.layers < 1:
+            raise InputError(f"--layers must be at least 1, got {o.layers}")
         if o.nr < 4:
             raise InputError(f"--nr must be at least 4, got {o.nr}")
         for name in ("re", "cfl"):
@@ -112,7 +119,7 @@ class TaylorCouette(Application):
 
     def create_particles(self):
         dr, h = self.dr, HDR * self.dr
-        nl = layers_for_support(2.0, HDR)
+        nl = self.options.layers or layers_for_support(2.0, HDR)
 
         def array(name, x, y):
             n = x.size
@@ -138,7 +145,7 @@ class TaylorCouette(Application):
     def wall_motions(self):
         """{wall: motion}: the outer ring turns at omega; with --wall-velocity profile both
         rings carry the exact profile continued into them (the inner ring stays in place)."""
-        if self.options.wall_velocity == "rigid":
+        if self.options.wall_velocity != "profile":
             return {"outer": rigid_rotation(OMEGA)}
         return {"outer": rigid_rotation(OMEGA, exact_tangential_velocity),
                 "inner": rigid_rotation(0.0, exact_tangential_velocity)}
@@ -147,7 +154,8 @@ class TaylorCouette(Application):
         o = self.options
         return SHTCScheme(["fluid"], 2, rho0=RHO0, c0=C0, cs=CS, h=HDR * self.dr, dr=self.dr, tau=self.tau,
                           model="dprz", cp=o.cp_factor * C0, walls=["inner", "outer"],
-                          moving_walls=sorted(self.wall_motions()), motions=self.wall_motions(), cfl=o.cfl)
+                          moving_walls=sorted(self.wall_motions()), motions=self.wall_motions(), cfl=o.cfl,
+                          wall_velocity="extrapolated" if o.wall_velocity == "extrapolated" else "prescribed")
 
     def post_step(self, solver):
         every = max(1, int(round(0.05 / solver.dt)))

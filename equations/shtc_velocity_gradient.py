@@ -117,3 +117,59 @@ class RenormalisedVelocityGradient(Equation):
                     s += g[3 * i + k] * hi[3 * k + j]
                 d_L[9 * d_idx + 3 * i + j] = s
 
+
+
+class BodyGradientVelocity(Equation):
+    """v_g = v for a body particle: the velocity that :class:`GhostVelocityGradient` reads."""
+
+    def initialize(self, d_idx, d_u, d_v, d_w, d_ug, d_vg, d_wg):
+        d_ug[d_idx] = d_u[d_idx]
+        d_vg[d_idx] = d_v[d_idx]
+        d_wg[d_idx] = d_w[d_idx]
+
+
+class WallGradientVelocity(Equation):
+    """v_g = 2 v_w - sum_f v_f w_wf / sum_f w_wf of a dummy-wall particle with prescribed velocity
+    v_w (Adami, Hu & Adams (2012), eqs. 22-23), or v_w where no body particle is in reach: the
+    body's velocity field continued linearly through the wall, for L only.  dest: a wall,
+    sources: the bodies."""
+
+    def initialize(self, d_idx, d_ug, d_vg, d_wg, d_wij):
+        d_ug[d_idx] = 0.0
+        d_vg[d_idx] = 0.0
+        d_wg[d_idx] = 0.0
+        d_wij[d_idx] = 0.0
+
+    def loop(self, d_idx, d_ug, d_vg, d_wg, d_wij, s_idx, s_u, s_v, s_w, WIJ):
+        d_ug[d_idx] += s_u[s_idx] * WIJ
+        d_vg[d_idx] += s_v[s_idx] * WIJ
+        d_wg[d_idx] += s_w[s_idx] * WIJ
+        d_wij[d_idx] += WIJ
+
+    def post_loop(self, d_idx, d_u, d_v, d_w, d_ug, d_vg, d_wg, d_wij):
+        s = d_wij[d_idx]
+        if s > 0.0:
+            d_ug[d_idx] = 2.0 * d_u[d_idx] - d_ug[d_idx] / s
+            d_vg[d_idx] = 2.0 * d_v[d_idx] - d_vg[d_idx] / s
+            d_wg[d_idx] = 2.0 * d_w[d_idx] - d_wg[d_idx] / s
+        else:
+            d_ug[d_idx] = d_u[d_idx]
+            d_vg[d_idx] = d_v[d_idx]
+            d_wg[d_idx] = d_w[d_idx]
+
+
+class GhostVelocityGradient(RenormalisedVelocityGradient):
+    """L_a = (sum_b m_b (v_g,a - v_g,b) (x) grad w_ab) H_a^-1: eq. 7 of Kincl, Peshkov, Pavelka &
+    Klika (2023) on the velocities v_g of :class:`BodyGradientVelocity` and
+    :class:`WallGradientVelocity` (walls whose velocity is extrapolated from the bodies)."""
+
+    def loop(self, d_idx, d_H, d_L, d_ug, d_vg, d_wg, s_idx, s_m, s_ug, s_vg, s_wg, XIJ, DWIJ):
+        mb = s_m[s_idx]
+        vij = declare("matrix(3)")
+        vij[0] = d_ug[d_idx] - s_ug[s_idx]
+        vij[1] = d_vg[d_idx] - s_vg[s_idx]
+        vij[2] = d_wg[d_idx] - s_wg[s_idx]
+        for i in range(3):
+            for j in range(3):
+                d_H[9 * d_idx + 3 * i + j] += mb * XIJ[i] * DWIJ[j]
+                d_L[9 * d_idx + 3 * i + j] += mb * vij[i] * DWIJ[j]

@@ -22,6 +22,9 @@ and C_lambda.  Walls (dummy particles) carry their own A, rho, lambda and T and 
 same equations (they enter the bodies' sums and forces through T_b and lambda_b); their
 positions and velocities are prescribed (``Integrator.add_motion``), never integrated, and
 their A is updated from their own L.  A lid's prescribed velocity therefore enters only L.
+With ``wall_velocity='extrapolated'`` the walls show, in L only, the ghost velocity 2 v_w minus
+the Shepard mean of the bodies' velocities around them (Adami, Hu & Adams 2012, eqs. 22-23),
+which removes most of the dummy walls' slip (docs/shtc.md).
 """
 import math
 
@@ -38,8 +41,12 @@ from ..equations.shtc_distortion import cayley_update
 from ..equations.shtc_penalty import PenaltyLambda, PenaltyLambdaConstant, TensilePenaltyForce
 from ..equations.shtc_relaxation import relax_rk4
 from ..equations.shtc_stress import MODELS, SHTCMomentum, SHTCStress
-from ..equations.shtc_velocity_gradient import KernelMoment, RenormalisedVelocityGradient
+from ..equations.shtc_velocity_gradient import (BodyGradientVelocity, GhostVelocityGradient, KernelMoment,
+                                                 RenormalisedVelocityGradient, WallGradientVelocity)
 from sphgen.equation import declare
+
+WALL_VELOCITIES = ("prescribed", "extrapolated")
+"""What a wall particle's velocity is in L: its own (the paper) or the bodies' extrapolated."""
 
 RK4_REAL_STABILITY = 2.785293563405282
 """|z| where classical RK4's stability region meets the negative real axis."""
@@ -171,11 +178,18 @@ class SHTCScheme(Scheme):
     with the |det A|^(5/3) factor of the thesis' eq. 2.11 (the paper omits it).  ``motions``:
     {moving wall: f(t, pa) -> {property: values}} prescribed at every stage's time (e.g. a
     rotating ring: positions and velocities), see ``Integrator.add_motion``.
+    ``wall_velocity``: the velocity a wall particle shows in L: 'prescribed' (the paper's
+    dummy walls and lid) or 'extrapolated' (2 v_w minus the Shepard mean of the bodies'
+    velocities around it, Adami, Hu & Adams (2012), eqs. 22-23; see docs/shtc.md).
     """
 
     def __init__(self, bodies, dim, rho0, c0, cs, h, dr, tau=math.inf, model="dprz", cp=0.0,
                  walls=(), moving_walls=(), cfl=0.05, masses="kernel", theta_det=False,
-                 kernel="wendland", motions=None):
+                 kernel="wendland", motions=None, wall_velocity="prescribed"):
+        if wall_velocity not in WALL_VELOCITIES:
+            raise InputError(f"SHTCScheme: wall_velocity must be one of {', '.join(WALL_VELOCITIES)}, "
+                             f"got {wall_velocity!r}")
+        self.wall_velocity = wall_velocity
         self.bodies, self.walls, self.moving_walls = list(bodies), list(walls), list(moving_walls)
         self.motions = dict(motions or {})
         if any(w not in self.moving_walls for w in self.motions):
@@ -244,6 +258,10 @@ class SHTCScheme(Scheme):
             for p in ("p", "crho", "lam", "clam", "au", "av", "aw", "hflag"):
                 if not pa.has(p):
                     pa.add_property(p)
+            if self.wall_velocity == "extrapolated" and self.walls:
+                for p in ("ug", "vg", "wg", "wij"):
+                    if not pa.has(p):
+                        pa.add_property(p)
             for p in ("H", "L", "T"):
                 pa.add_property(p, stride=9)
             if not pa.has("A") or "A" not in pa.data:
@@ -258,7 +276,12 @@ class SHTCScheme(Scheme):
     def get_equations(self):
         every = self.bodies + self.walls
         model = MODELS[self.model]
-        gradient = [RenormalisedVelocityGradient(d, every, dim=self.dim) for d in every]
+        if self.wall_velocity == "extrapolated" and self.walls:
+            gradient = [Group([BodyGradientVelocity(b) for b in self.bodies]
+                              + [WallGradientVelocity(w, self.bodies) for w in self.walls]),
+                        Group([GhostVelocityGradient(d, every, dim=self.dim) for d in every])]
+        else:
+            gradient = [Group([RenormalisedVelocityGradient(d, every, dim=self.dim) for d in every])]
         state = []
         for d in every:
             state += [SummationDensityWithConstant(d, every),
@@ -274,7 +297,7 @@ class SHTCScheme(Scheme):
         constants = [DensityConstant(d, every, rho0=self.rho0) for d in every]
         constants += [PenaltyLambdaConstant(d, every, cp=self.cp) for d in every]
         start.append(Group(constants))
-        return [[Group(gradient)], [Group(state), Group(force)], start]
+        return [gradient, [Group(state), Group(force)], start]
 
     def get_integrator(self):
         model = MODELS[self.model]

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from sphgen.codegen.render import render
-from sphgen.errors import StabilityError
+from sphgen.errors import InputError, StabilityError
 from sphgen.geometry import bcc_lattice, hexagonal_lattice
 from sphgen.kernels import WendlandQuinticC2
 from sphgen.particles import ParticleArray
@@ -326,10 +326,10 @@ def cavity_arrays(n=8):
     return [fluid, wall, lid], dr
 
 
-def cavity_scene(backend, steps=3):
+def cavity_scene(backend, steps=3, wall_velocity="prescribed"):
     arrays, dr = cavity_arrays()
     s = SHTCScheme(["fluid"], 2, rho0=1.0, c0=20.0, cs=20.0, h=HDR * dr, dr=dr, tau=0.01,
-                   walls=["wall", "lid"], moving_walls=["lid"])
+                   walls=["wall", "lid"], moving_walls=["lid"], wall_velocity=wall_velocity)
     sc, integ = build(arrays, s, backend)
     integ.add_motion("lid", lambda t, pa: {"u": min(t / 0.001, 1.0)})
     dt = 10 * s.get_timestep()
@@ -341,9 +341,10 @@ def cavity_scene(backend, steps=3):
     return {pa.name: pa for pa in arrays}, sc
 
 
-def test_compiled_matches_python_with_walls_lid_and_relaxation():
-    a, sca = cavity_scene("cython")
-    b, scb = cavity_scene("python")
+@pytest.mark.parametrize("wall_velocity", ["prescribed", "extrapolated"])
+def test_compiled_matches_python_with_walls_lid_and_relaxation(wall_velocity):
+    a, sca = cavity_scene("cython", wall_velocity=wall_velocity)
+    b, scb = cavity_scene("python", wall_velocity=wall_velocity)
     for name in a:
         assert sorted(a[name].data) == sorted(b[name].data)
         for k, arr in a[name].data.items():
@@ -362,6 +363,21 @@ def test_compiled_matches_python_with_walls_lid_and_relaxation():
     assert np.abs(a["lid"].L).max() > 0 and np.abs(f.L).max() > 0
     A = f.A.reshape(-1, 3, 3)
     assert np.abs(A - np.eye(3)).max() > 0
+    if wall_velocity == "extrapolated":
+        # ghost velocity 2 v_w - (Shepard mean of the fluid) where fluid is in reach, v_w elsewhere
+        # (Adami, Hu & Adams 2012, eqs. 22-23); the walls' own velocities are untouched
+        for w, vw in (("wall", 0.0), ("lid", 1.0)):
+            near = a[w].wij > 0
+            assert near.any() and (~near).any()
+            assert np.all(a[w].ug[~near] == vw) and np.all(a[w].u == vw)
+            assert np.abs(a[w].ug[near] - vw).max() > 1e-3
+
+
+def test_extrapolated_wall_velocity_is_checked():
+    arrays, dr = cavity_arrays()
+    with pytest.raises(InputError):
+        SHTCScheme(["fluid"], 2, rho0=1.0, c0=20.0, cs=20.0, h=HDR * dr, dr=dr, tau=0.01,
+                   walls=["wall", "lid"], wall_velocity="mirrored")
 
 
 def test_compiled_matches_python_for_the_solid():
