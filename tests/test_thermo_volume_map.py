@@ -135,3 +135,40 @@ def test_an_isotropic_expansion_at_fixed_J_or_Sigma_J_has_negative_stiffness(nu)
     assert k["det"] == pytest.approx(3 * m.kappa / m.mu, rel=1e-6)
     assert k["fixed"] == pytest.approx(-3.0, rel=1e-6)
     assert -1.4 < k["sigma"] < -0.99
+
+
+# ---------------------------------------------------------------------------------------
+# dj="volumetric" (variant full-vol, not the paper's): D_J on the jump of the mean stress
+# varsigma = (Sigma_F : F + 2 Sigma_H : H + 3 J Sigma_J) / 3J, applied to J, F and H together
+
+
+def test_volumetric_D_J_moves_J_F_H_together():
+    """J-dot = H : F-dot exactly (so J stays det F) on the smooth deformation, at every
+    particle, while the dissipation is on (the J rate differs from the one without D_J)."""
+    inner, every, true = drift_rates(6, jumps="raw", dj="volumetric")
+    assert every < 1e-12 * true
+    pa, dx = smooth_cube(6)
+    s, sc, integ = build(pa, dx, backend="cython", jumps="raw", dj="volumetric")
+    integ.initial_accelerations(0.0, 1e-3)
+    sc.compute(0, 0.0, 1e-3)
+    assert np.abs(pa.SD - pa.SJ).max() > 1.0        # it jumps the mean stress, not Sigma_J [Pa]
+    # and it does act: J-dot differs from the plain H : grad v (the paper-free rate)
+    plain = drift_rates(6, jumps="raw", dissipation="p")
+    assert np.abs(pa.aJ).max() != pytest.approx(plain[2], rel=1e-6)
+
+
+@pytest.mark.parametrize("form,jumps", [("E", "raw"), ("eta", "limited")])
+def test_volumetric_D_J_keeps_the_ballistic_identity(form, jumps):
+    """Eqs. 61/69 with varsigma in place of Sigma_J: sum V nu . dU/dt = heat - D_total,
+    D_total = 1/2 sum raw jump of varsigma (/Xi) times D^ab, every pair >= 0 (random
+    cloud, H and J independent of F)."""
+    from test_thermo_upwind import ballistic_rate, cloud, heat_term, pair_dissipation, rates
+    pa, dx = cloud(seed=3)
+    s, sc = rates(pa, dx, form=form, jumps=jumps, dj="volumetric")
+    heat, lhs = heat_term(s, pa), ballistic_rate(s, pa)
+    sj = pa.SJ.copy()
+    pa.SJ[:] = pa.SD           # the pair recomputation jumps pa.SJ
+    D, per_pair = pair_dissipation(s, sc, pa)
+    pa.SJ[:] = sj
+    assert heat < 0 and D > 0 and per_pair.min() >= 0.0
+    assert abs(lhs - (heat - D)) < 1e-10 * (abs(heat) + D), (lhs, heat, D)
