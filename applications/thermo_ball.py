@@ -127,7 +127,6 @@ class ThermoBall(ThermoSolid):
         pa.add_property("V", data=V)
         pa.add_property("area", data=area)
         pa.add_property("vfix", stride=3, data=vfix.ravel())
-        self.inner = inner
         print(f"thermo_ball: dx={dx:g} N={x.size} (paper: not given); volume {V.sum():.5g} m^3; heated inner "
               f"area {area_total:.5g} m^2 on {int(inner.sum())} particles; {int(top.sum())} punched, "
               f"{int(bottom.sum())} on the roller")
