@@ -5,7 +5,8 @@ checks of issue 12 on it, and the checkerboard indicator R[p].
 
 Variants (``--variant``): ``full`` is the paper's {p, F, H, J, E} scheme with D_J (eqs.
 54d, 66, 73), ``reduced`` the {p, F, H, E} scheme of its Fig. 16 (J = det F, no D_J),
-``full-no-DJ`` the full scheme without D_J (an ablation; docs/thermo.md).
+``full-no-DJ`` the full scheme without D_J (an ablation), ``full-vol`` the full scheme
+with D_J acting on the mean stress and on J, F, H together (not the paper's; docs/thermo.md).
 """
 import json
 import os
@@ -21,7 +22,8 @@ from sphgen.kernels import get_kernel
 from ..schemes.thermo_upwind import ThermoUpwindScheme
 
 VARIANTS = {"full": dict(reduced=False, dissipation=True), "reduced": dict(reduced=True, dissipation=True),
-            "full-no-DJ": dict(reduced=False, dissipation="p")}
+            "full-no-DJ": dict(reduced=False, dissipation="p"),
+            "full-vol": dict(reduced=False, dissipation=True, dj="volumetric")}
 
 
 class ThermoSolid(Application):
@@ -42,8 +44,9 @@ class ThermoSolid(Application):
     def add_scheme_options(self, group, variant_help):
         """The scheme's options; ``variant_help`` says why the default variant is the default."""
         group.add_argument("--variant", choices=tuple(VARIANTS), default=self.default_variant,
-                           help=f"full {{p, F, H, J, E}} (the paper's), reduced {{p, F, H, E}} (J = det F) or "
-                                f"full-no-DJ (D_J dropped); default %(default)s: {variant_help}")
+                           help=f"full {{p, F, H, J, E}} (the paper's), reduced {{p, F, H, E}} (J = det F), "
+                                f"full-no-DJ (D_J dropped) or full-vol (D_J on the mean stress, moving J, F, H "
+                                f"together); default %(default)s: {variant_help}")
         group.add_argument("--hdx", type=float, default=1.2, help="h / dx (default %(default)s)")
         group.add_argument("--kernel", choices=("wendland", "quintic"), default="wendland",
                            help="smoothing kernel (default %(default)s)")

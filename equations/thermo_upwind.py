@@ -82,13 +82,16 @@ class ThermoState(Equation):
     """Temperature (eq. 23 E-form, eq. 20 eta-form), the other thermal variable, Sigma_J and
     P (eqs. 10, 12) and the pressure -tr(J^-1 P F^T)/3, Ghavamian et al. (2021).
 
-    ``reduced``: the {p, F, H, E} scheme, J = det F (no J equation).
+    ``reduced``: the {p, F, H, E} scheme, J = det F (no J equation).  ``SD`` is the stress
+    the J dissipation jumps: Sigma_J (the paper's, eq. 66), or with ``volumetric`` the mean
+    stress varsigma = (Sigma_F : F + 2 Sigma_H : H + 3 J Sigma_J) / (3 J) (= P : F / 3J, the
+    conjugate of an isotropic change of F, H, J together; docs/thermo.md).
     """
 
-    switches = ("model", "form", "reduced")
+    switches = ("model", "form", "reduced", "volumetric")
 
     def initialize(self, d_idx, d_u, d_v, d_w, d_rho, d_F, d_H, d_J, d_E, d_eta, d_theta, d_P,
-                   d_SJ, d_p, d_mat):
+                   d_SJ, d_SD, d_p, d_mat):
         F = declare("matrix(9)")
         H = declare("matrix(9)")
         SF = declare("matrix(9)")
@@ -115,6 +118,9 @@ class ThermoState(Equation):
         sj = conjugate_stresses(self.model, F, H, J, theta, d_mat, SF, SH)
         first_piola(F, H, SF, SH, sj, P)
         d_SJ[d_idx] = sj
+        d_SD[d_idx] = sj
+        if self.volumetric:
+            d_SD[d_idx] = (ddot33(SF, F) + 2.0 * ddot33(SH, H)) / (3.0 * J) + sj
         for k in range(9):
             d_P[9 * d_idx + k] = P[k]
         d_p[d_idx] = -ddot33(P, F) / (3.0 * J)
@@ -152,8 +158,8 @@ class EntropyVariableGradients(Equation):
             for k in range(9):
                 d_gw[9 * d_idx + k] = 0.0
 
-    def loop(self, d_idx, d_L, d_theta, d_u, d_v, d_w, d_SJ, d_gradT, d_gw, d_gs, d_mat,
-             s_idx, s_V, s_theta, s_u, s_v, s_w, s_SJ, DWIJ):
+    def loop(self, d_idx, d_L, d_theta, d_u, d_v, d_w, d_SD, d_gradT, d_gw, d_gs, d_mat,
+             s_idx, s_V, s_theta, s_u, s_v, s_w, s_SD, DWIJ):
         L = declare("matrix(9)")
         g = declare("matrix(3)")
         jw = declare("matrix(3)")
@@ -172,7 +178,7 @@ class EntropyVariableGradients(Equation):
             jw[0] = s_u[s_idx] * rb - d_u[d_idx] * ra
             jw[1] = s_v[s_idx] * rb - d_v[d_idx] * ra
             jw[2] = s_w[s_idx] * rb - d_w[d_idx] * ra
-            js = s_SJ[s_idx] * rb - d_SJ[d_idx] * ra
+            js = s_SD[s_idx] * rb - d_SD[d_idx] * ra
             for i in range(3):
                 d_gs[3 * d_idx + i] += vb * js * g[i]
                 for k in range(3):
@@ -198,10 +204,13 @@ class UpwindFluxes(Equation):
 
     ``dissipation`` 0 switches the upwinding off, 2 keeps D_p only (an ablation: no D_J);
     ``external`` 0 drops f_R, t_B, s_R, Q_B;
-    ``reduced`` drops the J equation (J = det F).
+    ``reduced`` drops the J equation (J = det F);
+    ``volumetric``: D_J on the jump of the mean stress SD, applied as the isotropic rate
+    delta = sum_b D_J^ab / V to J, F and H together (J += delta, F += delta F / 3J,
+    H += 2 delta H / 3J), so that J stays det F (not the paper's; docs/thermo.md).
     """
 
-    switches = ("form", "reconstruct", "reduced", "dissipation", "external")
+    switches = ("form", "reconstruct", "reduced", "dissipation", "external", "volumetric")
 
     def initialize(self, d_idx, d_tint, d_aF, d_aJ, d_aE, d_aeta):
         for k in range(3):
@@ -215,9 +224,9 @@ class UpwindFluxes(Equation):
         else:
             d_aeta[d_idx] = 0.0
 
-    def loop(self, d_idx, d_V, d_L, d_P, d_H, d_u, d_v, d_w, d_theta, d_Q, d_SJ, d_rho, d_cp, d_cs,
+    def loop(self, d_idx, d_V, d_L, d_P, d_H, d_u, d_v, d_w, d_theta, d_Q, d_SD, d_rho, d_cp, d_cs,
              d_gw, d_gs, d_mat, d_tint, d_aF, d_aJ, d_aE, d_aeta,
-             s_idx, s_V, s_L, s_P, s_H, s_u, s_v, s_w, s_theta, s_Q, s_SJ, s_rho, s_cp, s_cs,
+             s_idx, s_V, s_L, s_P, s_H, s_u, s_v, s_w, s_theta, s_Q, s_SD, s_rho, s_cp, s_cs,
              s_gw, s_gs, DWIJ, XIJ):
         A = declare("matrix(9)")
         la = declare("matrix(3)")
@@ -288,7 +297,7 @@ class UpwindFluxes(Equation):
                 for k in range(3):
                     csk[k] = csk[k] / nc
                     jv[k] = vbb[k] * rb - va[k] * ra
-                js = s_SJ[s_idx] * rb - d_SJ[d_idx] * ra
+                js = s_SD[s_idx] * rb - d_SD[d_idx] * ra
                 jn = dot3(jv, csk)
                 if self.reconstruct:
                     # linear reconstruction at the pair midpoint, limited (docs/thermo.md)
@@ -325,7 +334,7 @@ class UpwindFluxes(Equation):
                 if not self.reduced and self.dissipation == 1:
                     d_aJ[d_idx] += nc * nc / (2.0 * rho * cp * nC) * js
 
-    def post_loop(self, d_idx, d_V, d_F, d_H, d_u, d_v, d_w, d_theta, d_Q, d_gradT, d_fb, d_sb,
+    def post_loop(self, d_idx, d_V, d_F, d_H, d_J, d_u, d_v, d_w, d_theta, d_Q, d_gradT, d_fb, d_sb,
                   d_tint, d_aF, d_aH, d_aJ, d_aE, d_aeta):
         G = declare("matrix(9)")
         F = declare("matrix(9)")
@@ -341,8 +350,14 @@ class UpwindFluxes(Equation):
         for k in range(9):
             d_aH[9 * d_idx + k] = R[k]
         if not self.reduced:
+            dj = d_aJ[d_idx] * vi
+            if self.volumetric:
+                f = dj / (3.0 * d_J[d_idx])
+                for k in range(9):
+                    d_aF[9 * d_idx + k] += f * F[k]
+                    d_aH[9 * d_idx + k] += 2.0 * f * d_H[9 * d_idx + k]
             load_tensor(d_H, d_idx, F)
-            d_aJ[d_idx] = ddot33(F, G) + d_aJ[d_idx] * vi
+            d_aJ[d_idx] = ddot33(F, G) + dj
         if self.form == 0:
             d_aE[d_idx] *= vi
             if self.external:

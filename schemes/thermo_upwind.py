@@ -40,7 +40,7 @@ STATE_9 = ("F", "H")
 FILLED = ("fb", "sb", "vB", "thB", "vfix", "tfix", "dEbc")    # set from Python (zero by default)
 VECTORS = ("gradT", "Q", "gs", "tint", "fb", "xc", "vB", "vfix")
 TENSORS = ("F", "H", "P", "L", "gw", "aF", "aH", "Fn", "Hn")
-SCALARS = ("J", "E", "eta", "theta", "p", "SJ", "cp", "cs", "dt_cfl", "aJ", "aE", "aeta", "sb",
+SCALARS = ("J", "E", "eta", "theta", "p", "SJ", "SD", "cp", "cs", "dt_cfl", "aJ", "aE", "aeta", "sb",
            "un", "vn", "wn", "xn", "yn", "zn", "Jn", "En", "etan", "tfix", "thB", "dEbc",
            "x0", "y0", "z0", "V")
 
@@ -295,7 +295,9 @@ class ThermoUpwindScheme(Scheme):
     reconstruction); ``projection``: the angular-momentum projection of eqs. 79-82;
     ``dt``: a fixed step instead of eq. 78 every step (it must respect eq. 78 at t = 0);
     ``dissipation`` False drops the upwinding (for tests), ``"p"`` keeps D_p but drops
-    D_J (an ablation, docs/thermo.md).  Essential conditions: a body
+    D_J (an ablation, docs/thermo.md); ``dj``: 'paper' (D_J on the jump of Sigma_J, moving
+    J only, eqs. 54d, 66) or 'volumetric' (on the jump of the mean stress, moving J, F and
+    H together so that J stays det F; docs/thermo.md).  Essential conditions: a body
     with a ``vfix`` property (3 flags per particle) gets its velocity components reset to
     ``vB`` (zero, or ``velocity(t, pa)``); one with ``tfix`` gets its temperature reset to
     ``thB`` (or ``temperature(t, pa)``).  ``add_load(body, f)`` adds a body force / heat
@@ -307,13 +309,17 @@ class ThermoUpwindScheme(Scheme):
     dim = 3
 
     def __init__(self, bodies, material, dx, hdx=1.2, kernel="wendland", form="E", reduced=False,
-                 jumps="raw", projection=False, dissipation=True, cfl=0.3, dt=None):
+                 jumps="raw", projection=False, dissipation=True, cfl=0.3, dt=None, dj="paper"):
         if not isinstance(material, ThermoElasticMaterial):
             raise InputError(f"ThermoUpwindScheme: material must be a ThermoElasticMaterial, got {material!r}")
         if form not in FORMS:
             raise InputError(f"ThermoUpwindScheme: form {form!r} must be one of {', '.join(FORMS)}")
         if dissipation not in (True, False, "p"):
             raise InputError(f"ThermoUpwindScheme: dissipation {dissipation!r} must be True, False or 'p'")
+        if dj not in ("paper", "volumetric"):
+            raise InputError(f"ThermoUpwindScheme: dj {dj!r} must be 'paper' or 'volumetric'")
+        if dj == "volumetric" and reduced:
+            raise InputError("ThermoUpwindScheme: dj='volumetric' needs the J equation (reduced=False)")
         if jumps not in JUMPS:
             raise InputError(f"ThermoUpwindScheme: jumps {jumps!r} must be one of {', '.join(JUMPS)}")
         for name, v in (("dx", dx), ("hdx", hdx), ("cfl", cfl), ("dt", 1.0 if dt is None else dt)):
@@ -329,6 +335,7 @@ class ThermoUpwindScheme(Scheme):
         self.form, self.reduced, self.jumps = form, bool(reduced), jumps
         self.projection, self.cfl = bool(projection), float(cfl)
         self.dissipation = 2 if dissipation == "p" else int(bool(dissipation))
+        self.volumetric = int(dj == "volumetric")
         self.dt = None if dt is None else float(dt)
         self.adaptive_dt = (("dt_cfl",), self.cfl) if dt is None else None
         self.loads = []
@@ -410,11 +417,13 @@ class ThermoUpwindScheme(Scheme):
             ext = int(any(name == b for name, _ in self.loads))
             rates += [Group([EntropyVariableGradients(b, [b], form=form, reconstruct=rec)], reference=True),
                       Group([UpwindFluxes(b, [b], form=form, reconstruct=rec, reduced=red,
-                                          dissipation=self.dissipation, external=ext)], reference=True)]
+                                          dissipation=self.dissipation, external=ext,
+                                          volumetric=self.volumetric)], reference=True)]
             if self.projection:
                 rates.append(Group([AngularMomentumProjection(b)]))
-            state.append(Group([ThermoState(b, model=model, form=form, reduced=red)]))
-            state_speeds.append(Group([ThermoState(b, model=model, form=form, reduced=red),
+            vol = self.volumetric
+            state.append(Group([ThermoState(b, model=model, form=form, reduced=red, volumetric=vol)]))
+            state_speeds.append(Group([ThermoState(b, model=model, form=form, reduced=red, volumetric=vol),
                                        WaveSpeeds(b, model=model, hmin=self.dx)]))
             once.append(Group([CorrectionMatrix(b, [b])], reference=True))
         return [rates, state, state_speeds, once]

@@ -55,3 +55,25 @@ def test_free_flight_on_the_1323_particle_lattice(tmp_path):
     check(r, h, 5.0)
     assert r["variant"] == "reduced" and r["ballistic_rise"] <= 1e-3 and r["ballistic_drop"] > 0
     assert np.abs(r["probe_u"]).max() > 0.01
+
+
+def test_full_vol_variant_flies_past_where_the_papers_full_scheme_stops(tmp_path):
+    """--variant full-vol (D_J moving J, F, H together; docs/thermo.md), dx = 1, the paper's
+    load, to 12 s: every check holds (the paper's full scheme stops at 7-10 s on this
+    lattice, the slow test below)."""
+    r, h = run(tmp_path / "vol", "--dx", "1", "--tf", "12", "--variant", "full-vol")
+    assert r["variant"] == "full-vol" and r["t"] >= 12.0
+    check(r, h, 5.0)
+    assert r["ballistic_rise"] <= 1e-3 and r["ballistic_drop"] > 0
+
+
+@pytest.mark.slow
+def test_full_vol_reaches_40_s_where_the_papers_full_scheme_stops(tmp_path):
+    """dx = 0.5, the paper's load: the full scheme stops (J or theta <= 0, 4.98 s measured),
+    full-vol reaches 40 s with every check (docs/thermo.md)."""
+    from sphgen.errors import BlowUpError
+    with pytest.raises((BlowUpError, SystemExit)):
+        run(tmp_path / "full", "--dx", "0.5", "--tf", "40", "--variant", "full")
+    r, h = run(tmp_path / "vol", "--dx", "0.5", "--tf", "40", "--variant", "full-vol")
+    check(r, h, 5.0)
+    assert r["ballistic_rise"] <= 1e-3 and r["J_min"] > 0.9
