@@ -9,10 +9,11 @@ from automan.api import Automator
 from automation.ctvf_cavity import CTVFCavityVoid
 from automation.ctvf_taylor_green import CTVFTaylorGreen
 from automation.taylor_green import TaylorGreenEDAC
+from automation.superfluid import Superfluid, SuperfluidQuick
 from automation.variational import VariationalDamBreak, VariationalEjection, VariationalEnergy, VariationalOrder
 
 PROBLEMS = [TaylorGreenEDAC, CTVFTaylorGreen, CTVFCavityVoid, VariationalDamBreak, VariationalOrder,
-            VariationalEnergy, VariationalEjection]
+            VariationalEnergy, VariationalEjection, Superfluid, SuperfluidQuick]
 
 if __name__ == "__main__":
     Automator(simulation_dir="outputs", output_dir="manuscript/figures",
