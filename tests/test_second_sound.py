@@ -182,3 +182,32 @@ def test_energy_error_at_N200_falls_with_M(tmp_path):
     print(f"N = 200, A = 0.01: energy errors {e}; log-log slope against M {slope:.3f}")
     assert e[50] <= 1e-6, e
     assert e[25] > e[50] > e[100], e
+
+
+def test_mirror_dummies_are_checked_and_refreshed():
+    """check_mirrors rejects a dummy that is not COOLER or whose partner is not FLUID;
+    refresh_mirrors reflects x, v, v_s and copies s, following gids after a reordering."""
+    from sphgen.equations.superfluid import COOLER, FLUID
+    from sphgen.particles import ParticleArray
+    from sphgen.schemes.superfluid import check_mirrors, refresh_mirrors
+
+    def cloud(ptype, mirror):
+        pa = ParticleArray("helium", x=[0.5, 1.5, -0.5], y=[0.5, 0.5, 0.5], u=[0.1, 0.2, 9.0],
+                           v=[0.3, 0.4, 9.0], s=[1.0, 2.0, 9.0])
+        for name, val in (("us", [0.5, 0.6, 9.0]), ("vs", [0.7, 0.8, 9.0])):
+            pa.add_property(name, data=np.array(val))
+        pa.add_property("ptype", dtype="int", data=np.array(ptype, dtype=np.int32))
+        pa.add_property("mirror", dtype="int", data=np.array(mirror, dtype=np.int32))
+        pa.add_property("msx", data=np.array([1.0, 1.0, -1.0]))
+        return pa
+    with pytest.raises(InputError):
+        check_mirrors(cloud([FLUID, FLUID, FLUID], [-1, -1, 0]))
+    with pytest.raises(InputError):
+        check_mirrors(cloud([COOLER, FLUID, COOLER], [-1, -1, 0]))
+    pa = cloud([FLUID, FLUID, COOLER], [-1, -1, 0])
+    check_mirrors(pa)
+    pa.permute(np.array([2, 0, 1]))      # memory order changes, gids follow
+    refresh_mirrors(pa)
+    d = int(np.flatnonzero(np.asarray(pa.mirror) >= 0)[0])
+    assert (pa.x[d], pa.y[d], pa.s[d]) == (-0.5, 0.5, 1.0)
+    assert (pa.u[d], pa.v[d], pa.us[d], pa.vs[d]) == (-0.1, 0.3, -0.5, 0.7)
