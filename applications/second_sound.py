@@ -1,15 +1,22 @@
 """Second-sound standing wave in He II (Kincl 2023, thesis sec. 3.5, eqs. 3.45-3.51).
 
 The square (0, L)^2, L = 1 cm, holds N x N helium particles on the cell-centred square
-lattice (spacing dr = L/N, mass rho0 dr^2), surrounded by dummy walls: ``n`` layers of
-ADIABATIC particles (v = v_s = 0, no entropy flux, diffusion or s grad T across a pair
-with a wall: adiabatic, eq. 3.45, and no-slip, eq. 3.46), n = ceil(2h/dr) so the kernel
-support is full.  At t = 0: v = v_s = 0, rho = rho0 (summation density with its constant,
-eq. 1.14) and s from eq. 3.51,
+lattice (spacing dr = L/N, mass rho0 dr^2), surrounded by dummy walls (``--boundary``):
+
+* ``mirror`` (default): 2 ceil(2h/dr) layers of dummies, each the mirror image of a fluid
+  particle across the nearest face(s), refreshed before every evaluation (position, s,
+  v and v_s with their normal components reversed): no heat and no normal flow across the
+  wall (adiabatic, eq. 3.45); the fluid evolves as a quarter of the periodic box (0, 2L)^2;
+* ``walls``: ceil(2h/dr) layers of ADIABATIC particles (v = v_s = 0, s = s0, no entropy
+  flux, diffusion or s grad T across a pair with a wall; no-slip, eq. 3.46);
+* ``periodic``: the periodic box (0, 2L)^2 with 2N x 2N particles, no walls.
+
+At t = 0: v = v_s = 0, rho = rho0 (summation density with its constant, eq. 1.14) and s
+from eq. 3.51,
 
     (s - s0)/s0 = A cos(pi x/L) cos(pi y/L) cos(sqrt(2) pi c2 t/L),
 
-the linear standing wave (walls at s0).  The run lasts one period, t = sqrt(2) L/c2.
+the linear standing wave.  The run lasts one period, t = sqrt(2) L/c2.
 Helium at T0 = 1.9 K (:data:`~sphgen.equations.superfluid_energy.HELIUM_1_9K`), c1 = 40 m/s;
 h = ``--hdx`` dr (default 1.5); dt = 2h/(M c1) with M the temporal resolution
 (``--M``, default 50); beta = mu = 0 unless given.  The thesis prints none of these: the
@@ -20,7 +27,11 @@ choices and their sources are in docs/superfluid.md.
 * ``entropy_error``: max over the sampled times of the RMS over the fluid particles of
   (s_a - s_exact(x_a, t))/(A s0), eq. 3.51 at the particle's current position;
 * ``energy_error``: max over the sampled times of |E(t) - E(0)|/E(0), E the total energy
-  (eqs. 3.23 + 3.32) summed over all particles, walls included;
+  (eqs. 3.23 + 3.32) summed over the fluid (mirror) or over all particles (walls, periodic);
+* ``frequency_ratio``: omega'/omega of the fit of the mode's amplitude to a0 cos(omega' t),
+  against ``frequency_ratio_lattice``, the dispersion of the zero-order operators on the
+  lattice (:func:`lattice_frequency_ratio`), and the entropy errors those frequencies alone
+  would give;
 * the entropy at (L/4, L/4) against eq. 3.51 (Shepard interpolation of the fluid), the
   largest |rho/rho0 - 1| and the drift of sum m s;
 
