@@ -242,7 +242,8 @@ def _field_panels(ax_list, shots, field, label, window, cmap):
         x, y = pa.x[k] * 1e3, pa.y[k] * 1e3
         c = field(pa, MODEL)[k]
         inside = (x > window[0]) & (x < window[1]) & (y > window[2]) & (y < window[3])
-        sc = ax.scatter(x[inside], y[inside], c=c[inside], s=1.0, cmap=cmap)
+        size = float(np.clip(3000.0 / max(int(inside.sum()), 1), 0.3, 12.0))   # fill the panel
+        sc = ax.scatter(x[inside], y[inside], c=c[inside], s=size, cmap=cmap)
         ax.set_aspect("equal")
         ax.set_xlim(window[:2])
         ax.set_ylim(window[2:])
