@@ -1,9 +1,15 @@
 #!/usr/bin/env python
 """Regenerate every figure: ``python automate.py`` (automan; see ``--help``).
 
-Simulations go to ``outputs/``, figures to ``manuscript/figures/``.  Finished cases
-(``info.json`` with ``completed: true``) are not run again.
+``python automate.py variational`` (or ``ctvf``, ``edac``, ``superfluid``,
+``superfluid_quick``) regenerates one paper's figures;
+automan's own names work too: a problem's class name (``VariationalOrder``) or its output
+folder name (``ctvf_fig13_cavity``).  Simulations go to ``outputs/``, figures to
+``manuscript/figures/``.  Finished cases (``info.json`` with ``completed: true``) are not
+run again.
 """
+import sys
+
 from automan.api import Automator
 
 from automation.ctvf_cavity import CTVFCavityVoid
@@ -12,9 +18,29 @@ from automation.taylor_green import TaylorGreenEDAC
 from automation.superfluid import Superfluid, SuperfluidQuick
 from automation.variational import VariationalDamBreak, VariationalEjection, VariationalEnergy, VariationalOrder
 
-PROBLEMS = [TaylorGreenEDAC, CTVFTaylorGreen, CTVFCavityVoid, VariationalDamBreak, VariationalOrder,
-            VariationalEnergy, VariationalEjection, Superfluid, SuperfluidQuick]
+# one entry per paper: the group name a user types
+PAPERS = {
+    "edac": [TaylorGreenEDAC],
+    "ctvf": [CTVFTaylorGreen, CTVFCavityVoid],
+    "variational": [VariationalDamBreak, VariationalOrder, VariationalEnergy, VariationalEjection],
+    "superfluid": [Superfluid],
+    "superfluid_quick": [SuperfluidQuick],
+}
+PROBLEMS = [cls for group in PAPERS.values() for cls in group]
+
+
+def problem_names(argv, papers=PAPERS):
+    """argv with paper names and output-folder names replaced by automan's class names."""
+    by_folder = {cls("outputs", "manuscript/figures").get_name(): cls.__name__ for group in papers.values() for cls in group}
+    out = []
+    for arg in argv:
+        if arg in papers:
+            out += [cls.__name__ for cls in papers[arg]]
+        else:
+            out.append(by_folder.get(arg, arg))
+    return out
+
 
 if __name__ == "__main__":
     Automator(simulation_dir="outputs", output_dir="manuscript/figures",
-              all_problems=PROBLEMS).run()
+              all_problems=PROBLEMS).run(problem_names(sys.argv[1:]))
