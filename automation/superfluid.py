@@ -1,9 +1,9 @@
 """The figures of Kincl (2023, thesis ch. 3), superfluid helium-4 (docs/superfluid.md).
 
-``python automate.py Superfluid`` runs the thesis' cases (second sound N = 100, 200, 300;
+``python automate.py superfluid`` runs the thesis' cases (second sound N = 100, 200, 300;
 the fountain's paper preset: days, docs/superfluid.md) and ``python automate.py
-SuperfluidQuick`` a coarse set (second sound N <= 100, the fountain's quick preset, under
-half an hour on 2 cores).  Each figure goes to a folder named after it:
+superfluid_quick`` a coarse set (second sound N <= 100, the fountain's quick preset, meant for
+under half an hour on 2 cores; not timed).  Each figure goes to a folder named after it:
 
 * ``fig3_1``: rho_n/rho and rho_s/rho against T: the linear model (eq. 3.25 with eq. 3.30)
   around 1.65 and 1.9 K.  The thesis plots Donnelly-Barenghi data that it does not print;
