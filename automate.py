@@ -1,7 +1,8 @@
 #!/usr/bin/env python
 """Regenerate every figure: ``python automate.py`` (automan; see ``--help``).
 
-``python automate.py variational`` (or ``ctvf``, ``edac``) regenerates one paper's figures;
+``python automate.py variational`` (or ``ctvf``, ``edac``, ``superfluid``,
+``superfluid_quick``) regenerates one paper's figures;
 automan's own names work too: a problem's class name (``VariationalOrder``) or its output
 folder name (``ctvf_fig13_cavity``).  Simulations go to ``outputs/``, figures to
 ``manuscript/figures/``.  Finished cases (``info.json`` with ``completed: true``) are not
@@ -14,6 +15,7 @@ from automan.api import Automator
 from automation.ctvf_cavity import CTVFCavityVoid
 from automation.ctvf_taylor_green import CTVFTaylorGreen
 from automation.taylor_green import TaylorGreenEDAC
+from automation.superfluid import Superfluid, SuperfluidQuick
 from automation.variational import VariationalDamBreak, VariationalEjection, VariationalEnergy, VariationalOrder
 
 # one entry per paper: the group name a user types
@@ -21,6 +23,8 @@ PAPERS = {
     "edac": [TaylorGreenEDAC],
     "ctvf": [CTVFTaylorGreen, CTVFCavityVoid],
     "variational": [VariationalDamBreak, VariationalOrder, VariationalEnergy, VariationalEjection],
+    "superfluid": [Superfluid],
+    "superfluid_quick": [SuperfluidQuick],
 }
 PROBLEMS = [cls for group in PAPERS.values() for cls in group]
 

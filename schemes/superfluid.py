@@ -14,6 +14,18 @@ Time integration, the Verlet-type scheme of sec. 3.4 (:class:`SuperfluidVerlet`)
 Rates use the most recent values.  Solid particles (``ptype`` ADIABATIC or COOLER) are
 never kicked: they keep v = v_s = 0, so they do not move, and v_n = v_ns = 0 on them;
 COOLER particles also keep their entropy (s = s0 gives T = T0).
+
+Mirrored dummy particles (``mirror_walls=True``): a COOLER particle (never integrated)
+with an integer property ``mirror`` >= 0 is a dummy that becomes, before every neighbour
+update and every evaluation of the rates, the mirror image of the fluid particle whose
+``gid`` is ``mirror`` across one or two axis-aligned walls: along each axis its position
+is ms x + mo and its v and v_s components are ms times the partner's (``msx, msy, msz`` =
+-1 across a wall normal to that axis, ``mox`` = twice the wall's coordinate), and it takes
+the partner's s.  So T is even and the normal components of v, v_s, v_n, J odd across the
+wall: no heat and no normal flow cross it (eq. 3.45).  With enough layers (the dummies
+within the support of the fluid must have full supports) the fluid evolves exactly as
+one cell of the mirror-symmetric periodic extension, so sum m s and the energy of the
+fluid are conserved as in a periodic box.
 """
 import numpy as np
 
@@ -132,9 +144,11 @@ class SuperfluidVerlet(Integrator):
     position_time = {"stage1": 0.0, "stage2": 0.5, "stage3": 0.5, "stage4": 0.0, "stage5": 0.0,
                      "stage6": 0.5, "stage7": 0.5}
 
-    def __init__(self, calibrate=(), reversible=False, rtol=1e-14, max_iterations=30, **steppers):
+    def __init__(self, calibrate=(), reversible=False, rtol=1e-14, max_iterations=30, mirror=(),
+                 **steppers):
         super().__init__(**steppers)
         self.calibrate = list(calibrate)
+        self.mirror = list(mirror)
         self.reversible = bool(reversible)
         self.rtol, self.max_iterations = float(rtol), int(max_iterations)
         self.iterations = {"kick": 0, "entropy": 0}
@@ -150,7 +164,23 @@ class SuperfluidVerlet(Integrator):
         for pa, rho in zip(arrays, target):
             pa.crho[:] = rho - pa.rho
 
+    def refresh_mirrors(self):
+        for name in self.mirror:
+            refresh_mirrors(self.scene.by_name[name])
+
+    def update_nnps(self):
+        """The neighbour lists, built with the mirrored dummies in place."""
+        self.refresh_mirrors()
+        super().update_nnps()
+
+    def compute_accelerations(self, index, t, dt):
+        """The rates, after the mirrored dummies took their partners' state."""
+        self.refresh_mirrors()
+        super().compute_accelerations(index, t, dt)
+
     def initial_accelerations(self, t, dt):
+        if self.mirror:   # the density constants with the dummies in place
+            self.update_nnps()
         if self.calibrate:
             self.calibrate_density(t, dt)
         self.compute_accelerations(1, t, dt)
@@ -220,7 +250,9 @@ class SuperfluidScheme(Scheme):
     the viscous regulariser eta^2 (default 0.04 h^2); ``gravity`` (gx, gy, gz) on v and v_s;
     ``dt`` the time step (default ``cfl`` h / c1); ``calibrate_density``: set the density
     constant C_a at t = 0 so the summation starts from the arrays' ``rho``; ``reversible``:
-    the symmetric variant of the integrator (see :class:`SuperfluidVerlet`).
+    the symmetric variant of the integrator (see :class:`SuperfluidVerlet`);
+    ``mirror_walls``: COOLER particles with ``mirror`` >= 0 are mirrored dummies (module
+    docstring); the diagnostics then leave them out.
     """
 
     output_props = ("x", "y", "z", "u", "v", "w", "us", "vs", "ws", "s", "rho", "p", "T", "rhon", "m",
@@ -228,7 +260,7 @@ class SuperfluidScheme(Scheme):
 
     def __init__(self, arrays=("helium",), dim=2, model=HELIUM_1_9K, h=None, beta=0.0, mu=0.0, eta2=None,
                  gravity=(0.0, 0.0, 0.0), kernel="wendland", dt=None, cfl=0.4, calibrate_density=True,
-                 reversible=False, rtol=1e-14, max_iterations=30, renormalise=False):
+                 reversible=False, rtol=1e-14, max_iterations=30, renormalise=False, mirror_walls=False):
         if dim not in (2, 3):
             raise InputError(f"SuperfluidScheme: dim must be 2 or 3, got {dim!r}")
         if h is None or not h > 0:
@@ -247,6 +279,7 @@ class SuperfluidScheme(Scheme):
         self.calibrate = bool(calibrate_density)
         self.reversible, self.rtol, self.max_iterations = bool(reversible), float(rtol), int(max_iterations)
         self.renormalise = int(bool(renormalise))
+        self.mirror_walls = bool(mirror_walls)
         self.masked = 0
         # the model is weakly compressible: a particle at the first-sound speed has blown up
         self.speed_limit = model.c1
@@ -279,6 +312,8 @@ class SuperfluidScheme(Scheme):
             for p in STATE_PROPS:
                 if not pa.has(p):
                     pa.add_property(p)
+            if self.mirror_walls:
+                check_mirrors(pa)
             for p in INPUT_PROPS:
                 if p not in pa.data:   # a state the user did not give starts at rest at s0
                     pa.add_property(p, default=self.model.s0 if p == "s" else 0.0)
@@ -321,6 +356,7 @@ class SuperfluidScheme(Scheme):
         step = SuperfluidStep(self.dim)
         return SuperfluidVerlet(calibrate=self.arrays if self.calibrate else (), reversible=self.reversible,
                                 rtol=self.rtol, max_iterations=self.max_iterations,
+                                mirror=self.arrays if self.mirror_walls else (),
                                 **{name: step for name in self.arrays})
 
     # ------------------------------------------------------------ time step
@@ -343,22 +379,81 @@ class SuperfluidScheme(Scheme):
     def energies(self, arrays):
         """{'kinetic', 'compression', 'heat', 'total', 'entropy'}: sums over all particles of
         m e_kin (coflow and counterflow, eq. 3.23), m c1^2 (ln(rho/rho0) + rho0/rho - 1) and
-        m T0 ((s - s0) + (s - s0)^2/(2 C_V)) (eq. 3.32), their total, and sum m s."""
+        m T0 ((s - s0) + (s - s0)^2/(2 C_V)) (eq. 3.32), their total, and sum m s.
+        With ``mirror_walls`` the mirrored dummies are left out (their state is a copy)."""
         out = dict(kinetic=0.0, compression=0.0, heat=0.0, entropy=0.0)
         for pa in arrays:
             if pa.name not in self.arrays:
                 continue
             s, v, vs = velocities(pa, self.dim)
-            out["kinetic"] += float(np.sum(pa.m * self.model.kinetic_energy(s, v, vs)))
-            out["compression"] += float(np.sum(pa.m * self.model.compression_energy(pa.rho)))
-            out["heat"] += float(np.sum(pa.m * self.model.heat_energy(s)))
-            out["entropy"] += float(np.sum(pa.m * s))
+            keep = (np.asarray(pa.mirror) < 0) if self.mirror_walls and pa.has("mirror") else slice(None)
+            m, s, v, vs, rho = pa.m[keep], s[keep], v[keep], vs[keep], pa.rho[keep]
+            out["kinetic"] += float(np.sum(m * self.model.kinetic_energy(s, v, vs)))
+            out["compression"] += float(np.sum(m * self.model.compression_energy(rho)))
+            out["heat"] += float(np.sum(m * self.model.heat_energy(s)))
+            out["entropy"] += float(np.sum(m * s))
         out["total"] = out["kinetic"] + out["compression"] + out["heat"]
         return out
 
 
 STABLE_CFL = 1.0
 STABLE_RULE = "h/c1, the acoustic limit of the Verlet scheme measured with sphgen stress"
+
+
+MIRROR_SIGNS = ("msx", "msy", "msz")
+MIRROR_SHIFTS = ("mox", "moy", "moz")
+AXES = (("x", "u", "us"), ("y", "v", "vs"), ("z", "w", "ws"))
+
+
+def check_mirrors(pa):
+    """Mirrored dummies: ``mirror`` (int, -1 for none) is the gid of a FLUID partner, the
+    dummy is COOLER, its signs ``msx, msy, msz`` are +-1 and its shifts ``mox, moy, moz``
+    are 0 where the sign is +1 (missing ones: +1 and 0)."""
+    if not pa.has("mirror"):
+        raise InputError(f"array '{pa.name}': mirror_walls needs the integer property 'mirror'")
+    for p, default in [(p, 1.0) for p in MIRROR_SIGNS] + [(p, 0.0) for p in MIRROR_SHIFTS]:
+        if p not in pa.data:
+            pa.add_property(p, data=np.full(pa.n, default))
+    mirror = np.asarray(pa.mirror)
+    dummy = mirror >= 0
+    ptype = np.asarray(pa.ptype)
+    index = gid_index(pa)
+    if np.any(mirror[dummy] >= index.size) or np.any(ptype[dummy] != COOLER):
+        raise InputError(f"array '{pa.name}': a mirrored dummy must be COOLER with a partner gid")
+    if np.any(index[mirror[dummy]] < 0) or np.any(ptype[index[mirror[dummy]]] != FLUID):
+        raise InputError(f"array '{pa.name}': a mirrored dummy's partner must be FLUID")
+    for sign, shift in zip(MIRROR_SIGNS, MIRROR_SHIFTS):
+        sg, sh = np.asarray(pa.get(sign))[dummy], np.asarray(pa.get(shift))[dummy]
+        if not (np.all(np.abs(sg) == 1.0) and np.all(sh[sg > 0] == 0.0)):
+            raise InputError(f"array '{pa.name}': mirrored dummies need {sign} = +-1 and {shift} = 0 "
+                             "where it is +1")
+
+
+def gid_index(pa):
+    """index[gid] = the particle's current position in memory (-1 for unused gids)."""
+    gid = np.asarray(pa.gid)
+    index = np.full(int(gid.max()) + 1 if gid.size else 0, -1, dtype=np.int64)
+    index[gid] = np.arange(gid.size)
+    return index
+
+
+def refresh_mirrors(pa):
+    """Each mirrored dummy becomes the image of its partner: along each axis,
+    x = ms x_partner + mo, and v, v_s times ms; s copied."""
+    mirror = np.asarray(pa.mirror)
+    dummy = np.flatnonzero(mirror >= 0)
+    if not dummy.size:
+        return
+    src = gid_index(pa)[mirror[dummy]]
+    pa.s[dummy] = pa.s[src]
+    for (x, u, us), sign, shift in zip(AXES, MIRROR_SIGNS, MIRROR_SHIFTS):
+        if x not in pa.data:
+            continue
+        ms = pa.get(sign)[dummy]
+        pa.get(x)[dummy] = ms * pa.get(x)[src] + pa.get(shift)[dummy]
+        for c in (u, us):
+            if c in pa.data:
+                pa.get(c)[dummy] = ms * pa.get(c)[src]
 
 
 def velocities(pa, dim):
