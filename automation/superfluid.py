@@ -198,8 +198,10 @@ def fig3_5(sim_dir, out_dir, cfg):
             continue
         fs = np.array(res["flux_series"])
         v = fs[:, 1] / (MODEL.rho0 * 2 * R_CAP)   # eq. 3.57: Q = rho0 v_jet 2 r_cap
-        k = min(10, len(v))
-        ax.plot(fs[:, 0], np.convolve(v, np.ones(k) / k, "same"), "-", color=color, label=f"{W} W/m")
+        k = min(10, len(v))   # moving mean over k output intervals, no edge padding
+        box = np.ones(k) / k
+        ax.plot(np.convolve(fs[:, 0], box, "valid"), np.convolve(v, box, "valid"), "-", color=color,
+                label=f"{W} W/m (moving mean of {k})")
         ax.axhline(res["v_jet_theory"], color=color, ls="--", label=f"eqs. 3.56-3.57, {W} W/m")
         out[W] = {"v_jet": res["v_jet"], "v_jet_theory": res["v_jet_theory"], "flux_error": res["flux_error"]}
     if not ax.lines:
