@@ -289,15 +289,20 @@ class Application:
                 "dim": self.dim, "sphgen_version": __version__}
 
     def neighbour_pairs_per_step(self, flops=False):
-        """Neighbour pairs visited in one step (all evaluations and passes); with
-        ``flops``, the estimated floating-point operations they cost
-        (:func:`sphgen.codegen.describe.loop_flops`)."""
+        """Neighbour pairs visited in one step (all evaluations and passes), on the last
+        neighbour lists; with ``flops``, the estimated floating-point operations they cost
+        (:func:`sphgen.codegen.describe.loop_flops`).  Each equation set counts as often as
+        the integrator ran it per step (start-up sets and fixed-point iterations included),
+        or once per step before any step."""
         from .codegen.describe import loop_flops
-        plan = self.scene.plan
-        n_eval = self.solver.integrator.n_evaluations
-        rows = plan.group_plans
-        total = 0
-        for k in range(n_eval):
+        integ = self.solver.integrator
+        rows = self.scene.plan.group_plans
+        if integ.steps_taken:
+            per_step = {k: n / integ.steps_taken for k, n in integ.set_runs.items()}
+        else:
+            per_step = {k: 1.0 for k in range(integ.n_evaluations)}
+        total = 0.0
+        for k, times in sorted(per_step.items()):
             row = rows[k] if len(rows) > 1 else rows[0]
             for gp in row:
                 for dest, npass in gp.passes.items():
@@ -305,8 +310,8 @@ class Application:
                         off, _ = (self.scene.nnps.reference_neighbours(dest, loop.source) if gp.group.reference
                                   else self.scene.nnps.neighbours(dest, loop.source))
                         pairs = int(off[-1]) * max(1, gp.group.iterations)
-                        total += pairs * (loop_flops(npass, loop) if flops else 1)
-        return total
+                        total += times * pairs * (loop_flops(npass, loop) if flops else 1)
+        return int(round(total))
 
     def _info(self, completed, error=None):
         s, sc, opts = self.solver, self.scene, self.options

@@ -50,6 +50,8 @@ class Integrator:
         self.steppers = steppers
         self.scene = None
         self.nnps_updates = 0
+        self.steps_taken = 0
+        self.set_runs = {}  # equation set -> times run in this process (for the pair counts)
         self.motions = []      # (array, f(t, pa) -> {prop: values})
         self.clamps = []       # (array, gids, {prop: value})
         self.t_step, self.dt_step = 0.0, 0.0
@@ -79,6 +81,7 @@ class Integrator:
         """One step from t (what the solver calls): ``one_timestep`` with the step's times known."""
         self.t_step, self.dt_step = t, dt
         self.one_timestep(t, dt)
+        self.steps_taken += 1
 
     def attach(self, scene):
         self.scene = scene
@@ -94,6 +97,7 @@ class Integrator:
             self.impose(self.t_step + self.position_time.get(name, 1.0) * self.dt_step)
 
     def compute_accelerations(self, index, t, dt):
+        self.set_runs[index] = self.set_runs.get(index, 0) + 1
         self.scene.compute(index, t, dt)
 
     def update_nnps(self):

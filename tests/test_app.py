@@ -115,3 +115,40 @@ def test_show_plan_prints_plan_and_exits(tmp_path, capsys):
 def test_sphgen_list_names_taylor_green(capsys):
     assert main(["list"]) == 0
     assert "taylor_green" in capsys.readouterr().out.split()
+
+
+
+
+def _pairs_of_set(app, k):
+    """Pair visits of one run of equation set k on the current lists, counted from the plan."""
+    rows = app.scene.plan.group_plans
+    total = 0
+    for gp in rows[k] if len(rows) > 1 else rows[0]:
+        for dest, npass in gp.passes.items():
+            for loop in npass.sources:
+                off, _ = (app.scene.nnps.reference_neighbours(dest, loop.source) if gp.group.reference
+                          else app.scene.nnps.neighbours(dest, loop.source))
+                total += int(off[-1]) * max(1, gp.group.iterations)
+    return total
+
+
+def test_pair_count_follows_the_evaluations_the_integrator_ran(tmp_path):
+    """info.json's pairs per step: each equation set as often as the integrator ran it per step
+    (EDAC's kick-drift-kick: sets 0 and 1 every step, set 1 once more before the first;
+    SHTC: sets 0 and 1 every step, its start-up set 2 once)."""
+    app = tg(["--tf", "0.02", "-d", str(tmp_path / "a"), "--disable-output", "--no-openmp"])
+    integ = app.solver.integrator
+    steps = integ.steps_taken
+    assert steps == app.solver.step > 5 and integ.set_runs == {0: steps, 1: steps + 1}
+    expected = _pairs_of_set(app, 0) + _pairs_of_set(app, 1) * (steps + 1) / steps
+    assert app.neighbour_pairs_per_step() == round(expected)
+
+    plate = load_application("beryllium_plate")()
+    plate.run(["-d", str(tmp_path / "p"), "--disable-output", "--no-progress", "--threads", "1",
+               "--nw", "8", "--tf", "1e-6"])
+    integ = plate.solver.integrator
+    steps = integ.steps_taken
+    assert steps > 5 and integ.set_runs == {0: steps, 1: steps + 1, 2: 1}
+    one = [_pairs_of_set(plate, k) for k in range(3)]
+    assert one[2] > 0
+    assert plate.neighbour_pairs_per_step() == round(one[0] + one[1] * (steps + 1) / steps + one[2] / steps)
