@@ -82,13 +82,16 @@ def quintic_dwdr(r=0.0, h=1.0, fac=1.0, dim=2):
     sigma_d).  The scene's kernel is callable only at h_ab (the DWIJ symbol); this helper
     gives the reduced-h gradient of the GTVF and is tested against sphgen.kernels."""
     q = r / h
-    a = 0.5 * (3.0 - q + fabs(3.0 - q))    # (3 - q)+, branch-free as QuinticSpline.dwdr
-    b = 0.5 * (2.0 - q + fabs(2.0 - q))
-    c = 0.5 * (1.0 - q + fabs(1.0 - q))
-    a2 = a * a
-    b2 = b * b
-    c2 = c * c
-    val = a2 * a2 - 6.0 * b2 * b2 + 15.0 * c2 * c2
+    a = 3.0 - q
+    b = 2.0 - q
+    c = 1.0 - q
+    val = 0.0
+    if q < 1.0:
+        val = a * a * a * a - 6.0 * b * b * b * b + 15.0 * c * c * c * c
+    elif q < 2.0:
+        val = a * a * a * a - 6.0 * b * b * b * b
+    elif q < 3.0:
+        val = a * a * a * a
     s = fac / h
     if dim > 1:
         s = s / h
