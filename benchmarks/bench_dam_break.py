@@ -25,7 +25,7 @@ import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from pysph_baseline import find_pysph_python  # noqa: E402
-from roofline import peak_gflops, roofline_line  # noqa: E402
+from roofline import median_run_line, peak_gflops  # noqa: E402
 
 SPHGEN = os.path.join(os.path.dirname(sys.executable), "sphgen")
 
@@ -114,8 +114,7 @@ def main():
     peak = peak_gflops()
     for config in CONFIGS:
         for threads in (1, 2):
-            rows = sorted(res[(config, threads)], key=lambda x: x["wall"])
-            print(roofline_line(rows[len(rows) // 2]["info"], peak, f"{config}, {threads} thread(s)"))
+            print(median_run_line(res[(config, threads)], peak, f"{config}, {threads} thread(s)"))
     for config in CONFIGS:
         s1, s2 = us[(config, 1)], us[(config, 2)]
         print(f"{config}: 1 -> 2 threads {s1[0] / s2[0]:.2f}x")

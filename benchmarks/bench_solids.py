@@ -21,7 +21,7 @@ import tempfile
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from bench_dam_break import pysph_app, sphgen_app  # noqa: E402
 from pysph_baseline import find_pysph_python  # noqa: E402
-from roofline import peak_gflops, roofline_line  # noqa: E402
+from roofline import median_run_line, peak_gflops  # noqa: E402
 
 PYSPH_DT = 1e-8     # solid_mech.rings' fixed step
 CASES = {"sphgen rings": ("rings", ["--dx", "0.0005", "--one-body"]),
@@ -70,8 +70,7 @@ def main():
     peak = peak_gflops()
     for label in CASES:
         for threads in (1, 2):
-            rows = sorted(res[(label, threads)], key=lambda x: x["wall"])
-            print(roofline_line(rows[len(rows) // 2]["info"], peak, f"{label}, {threads} thread(s)"))
+            print(median_run_line(res[(label, threads)], peak, f"{label}, {threads} thread(s)"))
         print(f"{label}: 1 -> 2 threads {us[(label, 1)] / us[(label, 2)]:.2f}x")
         for threads in (1, 2):
             if ("pysph solid_mech.rings", threads) in us:

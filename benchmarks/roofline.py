@@ -103,6 +103,12 @@ def roofline_line(info, peak, label=""):
             f"peak ({peak['avx']:.1f}); pair passes and everything around them included")
 
 
+def median_run_line(rows, peak, label=""):
+    """``roofline_line`` of the run with the median wall time (rows: dicts with "wall", "info")."""
+    rows = sorted(rows, key=lambda x: x["wall"])
+    return roofline_line(rows[len(rows) // 2]["info"], peak, label)
+
+
 if __name__ == "__main__":
     p = peak_gflops()
     print(f"peak, one core: scalar FMA {p['scalar']:.1f} GFLOP/s, AVX2 FMA {p['avx']:.1f} GFLOP/s; "
