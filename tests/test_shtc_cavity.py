@@ -23,7 +23,7 @@ def run_cavity(out, *args):
 
 
 def test_lid_drags_the_fluid_and_stays_in_place(tmp_path):
-    res, app = run_cavity(tmp_path / "c", "--nx", "20", "--tf", "0.3", "--dt", "5e-5")
+    res, app = run_cavity(tmp_path / "c", "--nx", "20", "--tf", "0.3", "--dt", "5e-5", "--average-from", "0.1")
     a = app.scene.by_name
     lid, wall, fluid = a["lid"], a["wall"], a["fluid"]
     assert np.all(lid.u == pytest.approx(0.3 / 0.4)) and np.all(lid.v == 0)
@@ -37,6 +37,15 @@ def test_lid_drags_the_fluid_and_stays_in_place(tmp_path):
     assert np.abs(fluid.u[fluid.y < 0.5]).mean() < 0.1 * u[1]
     assert res["dt_over_tau"] == pytest.approx(5e-5 / (6 * 0.01 / 400))
     assert res["viscosity_factor"] == pytest.approx(viscosity_factor(res["dt_over_tau"]))
+    # the centre lines averaged over the samples t = 0.1, 0.2, 0.3 (the last one is the final state):
+    # the mean profile lies between the samples, so its deviation is at most the largest sampled one
+    assert res["n_averaged"] == 3 and res["averaged_from"] == pytest.approx(0.1)
+    lo, hi = res["ghia_error_window"]
+    assert lo <= res["ghia_error"] <= hi and res["ghia_error_averaged"] <= hi
+    assert lo < hi                                  # the flow is still starting up: the samples differ
+    ua = np.array(res["u_centre_averaged"])
+    assert np.all(ua[1:6] < u[1:6]) and np.all(ua[1:6] > 0)   # under the lid the flow accelerates
+    assert res["ghia_error_interior"] <= res["ghia_error"]
 
 
 def test_extrapolated_wall_velocity_drives_the_fluid_harder(tmp_path):
