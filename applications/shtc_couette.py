@@ -45,7 +45,7 @@ class SHTCCouette(Application):
     def add_user_options(self, group):
         group.add_argument("--ny", type=int, default=40, help="particles across: dr = 1/ny (default %(default)s)")
         group.add_argument("--nu", type=float, default=1.0, help="kinematic viscosity (default %(default)s)")
-        add_wall_velocity_option(group)
+        add_wall_velocity_option(group, default="prescribed")   # the walls of [P] unless told
         group.add_argument("--cs", type=float, default=CS, help="shear sound speed (default %(default)s, the cavity's)")
 
     def consume_user_options(self, o):

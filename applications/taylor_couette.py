@@ -7,8 +7,10 @@ dummy walls of ceil(2h/dr) = 3 layers that carry their own rho, lambda, A and T 
 scheme's own equations (they enter the fluid's sums and forces); the outer ring's positions
 and velocities are prescribed, x(t) = Rot(omega t) x(0), v = omega (-y, x), at the times of
 the integrator's stages (the half step for L, the full step for the force);
-``--wall-velocity extrapolated`` lets the rings show, in L only, 2 v_rigid minus the fluid's
-Shepard mean around them (Adami et al. 2012; not the paper's text).  DPRZ with
+by default (``--wall-velocity extrapolated``) the rings show, in L only, 2 v_rigid minus the
+fluid's Shepard mean around them (Adami et al. 2012); ``--wall-velocity rigid`` is the paper's
+text (the rings show their rigid-body velocity, which slips by about a kernel width; the
+choice is argued in docs/shtc.md).  DPRZ with
 rho0 = 1, c0 = 20, cs = 40, c_p = 0.01 c0, nu = omega R2 (R2 - R1) / Re (Re = 20: nu = 0.1)
 and tau = 6 nu / cs^2 (eq. 29).  Particles on Vogel's sunflower lattice (area dr^2 each, as in the authors'
 code; ``--lattice rings``: concentric circles), dr = (R2 - R1) / ``--nr`` (paper, Table 1: 30), h = 1.5 dr, dt from eq. 26.
@@ -93,7 +95,7 @@ class TaylorCouette(Application):
         group.add_argument("--lattice", choices=("vogel", "rings"), default="vogel",
                            help="particle layout: Vogel's sunflower (the authors' code) or concentric "
                            "circles (default %(default)s)")
-        group.add_argument("--wall-velocity", choices=("rigid", "extrapolated", "profile"), default="rigid",
+        group.add_argument("--wall-velocity", choices=("rigid", "extrapolated", "profile"), default="extrapolated",
                            help="rigid: the rings' rigid-body velocities (the paper's text); extrapolated: "
                            "in L the rings show 2 v_rigid minus the Shepard mean of the fluid's velocity "
                            "around them (Adami et al. 2012); profile: the exact profile (eq. 28) continued "

@@ -53,7 +53,7 @@ def test_extrapolated_wall_velocity_drives_the_fluid_harder(tmp_path):
     the lid passes more momentum: at t = 0.3 (nx = 20) the fluid's kinetic energy is 4.1e-4
     against 1.1e-4, u at y = 0.953 on x = 0.5 is 0.147 against 0.116 (docs/shtc.md)."""
     common = ("--nx", "20", "--tf", "0.3", "--dt", "5e-5")
-    paper, _ = run_cavity(tmp_path / "p", *common)
+    paper, _ = run_cavity(tmp_path / "p", *common, "--wall-velocity", "prescribed")
     extra, app = run_cavity(tmp_path / "e", *common, "--wall-velocity", "extrapolated")
     assert extra["kinetic_energy"] > 2.0 * paper["kinetic_energy"], (extra["kinetic_energy"], paper["kinetic_energy"])
     assert extra["u_centre"][4] > paper["u_centre"][4] + 0.02
@@ -76,15 +76,33 @@ def test_eq_26_step_above_the_relaxation_limit_is_refused(tmp_path):
         run_cavity(tmp_path / "c", "--nx", "20", "--tf", "0.1")
 
 
+@pytest.fixture(scope="module")
+def re100_nx40(tmp_path_factory):
+    """Re = 100, nx = 40, cs = 10, dt = tau/3 (nu_eff = nu, see viscosity_factor), extrapolated
+    wall and lid velocity (the default), t = 12, centre lines averaged over 6 <= t <= 12."""
+    res, _ = run_cavity(tmp_path_factory.mktemp("re100") / "nx40", "--nx", "40", "--cs", "10", "--dt", "2e-4",
+                        "--tf", "12", "--average-from", "6")
+    return res
+
+
 @pytest.mark.slow
-@pytest.mark.xfail(reason="measured 0.101 at nx = 40, t = 12 (0.077-0.120 over 6 <= t <= 12, "
-                   "docs/shtc.md): the core flow is two thirds of Ghia's", strict=False)
-def test_re100_centrelines_within_005_of_ghia(tmp_path):
-    """The issue's check: within 0.05 of Ghia at every point more than 2 dr from the lid (t = 12,
-    settled), at dt = tau/3 (the step whose viscosity is nu, see viscosity_factor) with cs = 10."""
-    res, _ = run_cavity(tmp_path / "re100", "--nx", "40", "--cs", "10", "--dt", "2e-4", "--tf", "12")
-    assert res["viscosity_factor"] == pytest.approx(1.0, abs=1e-3)
-    assert res["ghia_error"] < 0.05, res
+def test_re100_time_averaged_centrelines_within_005_of_ghia_inside(re100_nx40):
+    """The centre lines averaged over 6 <= t <= 12 (61 samples) are within 0.05 of Ghia at every
+    point more than 2 dr from every wall: measured 0.039 (docs/shtc.md)."""
+    assert re100_nx40["viscosity_factor"] == pytest.approx(1.0, abs=1e-3)
+    assert re100_nx40["n_averaged"] == 61
+    assert re100_nx40["ghia_error_averaged_interior"] < 0.05, re100_nx40
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(reason="measured at nx = 40, t = 12: 0.045 instantaneous but 0.025-0.152 over 6 <= t <= 12 "
+                   "(particle-scale velocity noise under the probes); averaged 0.051, from Ghia's wall point "
+                   "v(1, 0.5) = 0 where the probe mixes wall and downflow (docs/shtc.md)", strict=False)
+def test_re100_centrelines_within_005_of_ghia(re100_nx40):
+    """The issue's check: within 0.05 of Ghia at every point more than 2 dr from the lid, at the
+    final time and on the time-averaged centre lines."""
+    assert re100_nx40["ghia_error"] < 0.05, re100_nx40
+    assert re100_nx40["ghia_error_averaged"] < 0.05, re100_nx40
 
 
 @pytest.mark.slow
