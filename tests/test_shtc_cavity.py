@@ -62,6 +62,13 @@ def test_extrapolated_wall_velocity_drives_the_fluid_harder(tmp_path):
     assert lid.ug.max() > 0.3 / 0.4 + 0.1                                         # its ghost velocity is not
 
 
+def test_wall_velocity_defaults():
+    """The cavity's walls and lid show the extrapolated velocity in L unless told; the Couette check
+    of the paper's walls keeps the paper's (docs/shtc.md)."""
+    assert load_application("shtc_cavity")().parser().parse_args([]).wall_velocity == "extrapolated"
+    assert load_application("shtc_couette")().parser().parse_args([]).wall_velocity == "prescribed"
+
+
 def test_filling_lattice_stands_half_a_row_from_the_walls():
     for nx in (20, 40, 200):
         x, y = filling_lattice(1.0 / nx)
