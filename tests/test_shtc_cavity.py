@@ -113,11 +113,13 @@ def test_re100_centrelines_within_005_of_ghia(re100_nx40):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(reason="measured 0.059 at nx = 80, t = 12 (0.050-0.092, mean 0.066, over 6 <= t <= 12; "
-                   "0.129 with the paper's walls), docs/shtc.md", strict=False)
+@pytest.mark.xfail(reason="measured 0.059 at nx = 80, t = 12 (0.050-0.092 over 6 <= t <= 12; 0.062 on the "
+                   "time-averaged centre lines: the downflow along the right wall is too strong; 0.129 with "
+                   "the paper's walls), docs/shtc.md", strict=False)
 def test_re100_nx80_extrapolated_walls_within_005_of_ghia(tmp_path):
     """The issue's check at nx = 80 with the walls' and lid's velocity in L extrapolated from the
     fluid (Adami et al. 2012), dt = tau/3, cs = 10, t = 12."""
     res, _ = run_cavity(tmp_path / "e80", "--nx", "80", "--cs", "10", "--dt", "2e-4", "--tf", "12",
-                        "--wall-velocity", "extrapolated")
+                        "--wall-velocity", "extrapolated", "--average-from", "6")
     assert res["ghia_error"] < 0.05, res
+    assert res["ghia_error_averaged"] < 0.05, res
