@@ -92,24 +92,22 @@ def re100_nx40(tmp_path_factory):
     return res
 
 
+NX40_NOISE = ("measured at nx = 40: 0.045 at t = 12 but 0.025-0.152 over 6 <= t <= 12 (particle-scale velocity "
+              "noise under the probes); averaged 0.051, from Ghia's wall point v(1, 0.5) = 0 (docs/shtc.md)")
+
+
 @pytest.mark.slow
-def test_re100_time_averaged_centrelines_within_005_of_ghia_inside(re100_nx40):
-    """The centre lines averaged over 6 <= t <= 12 (61 samples) are within 0.05 of Ghia at every
-    point more than 2 dr from every wall: measured 0.039 (docs/shtc.md)."""
+@pytest.mark.parametrize("measure", [
+    "ghia_error_averaged_interior",                                             # measured 0.039
+    pytest.param("ghia_error", marks=pytest.mark.xfail(reason=NX40_NOISE, strict=False)),
+    pytest.param("ghia_error_averaged", marks=pytest.mark.xfail(reason=NX40_NOISE, strict=False))])
+def test_re100_centrelines_within_005_of_ghia(re100_nx40, measure):
+    """Within 0.05 of Ghia: the issue's check (points more than 2 dr from the lid, at the final
+    time), the same on the centre lines averaged over 6 <= t <= 12 (61 samples), and the averaged
+    lines over the points more than 2 dr from every wall (docs/shtc.md)."""
     assert re100_nx40["viscosity_factor"] == pytest.approx(1.0, abs=1e-3)
     assert re100_nx40["n_averaged"] == 61
-    assert re100_nx40["ghia_error_averaged_interior"] < 0.05, re100_nx40
-
-
-@pytest.mark.slow
-@pytest.mark.xfail(reason="measured at nx = 40, t = 12: 0.045 instantaneous but 0.025-0.152 over 6 <= t <= 12 "
-                   "(particle-scale velocity noise under the probes); averaged 0.051, from Ghia's wall point "
-                   "v(1, 0.5) = 0 where the probe mixes wall and downflow (docs/shtc.md)", strict=False)
-def test_re100_centrelines_within_005_of_ghia(re100_nx40):
-    """The issue's check: within 0.05 of Ghia at every point more than 2 dr from the lid, at the
-    final time and on the time-averaged centre lines."""
-    assert re100_nx40["ghia_error"] < 0.05, re100_nx40
-    assert re100_nx40["ghia_error_averaged"] < 0.05, re100_nx40
+    assert re100_nx40[measure] < 0.05, re100_nx40
 
 
 @pytest.mark.slow
