@@ -20,14 +20,13 @@ run (the jet adds no particles; the neighbour count per particle changes little)
 import argparse
 import math
 import os
-import statistics
 import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from bench_dam_break import sphgen_app  # noqa: E402
-from bench_solids import per_particle_step  # noqa: E402
-from roofline import median_run_line, peak_gflops  # noqa: E402
+from bench_solids import per_particle_step, print_per_particle_step, print_thread_scaling  # noqa: E402
+from roofline import peak_gflops  # noqa: E402
 
 from sphgen.applications.fountain import PRESETS  # noqa: E402
 
@@ -73,18 +72,10 @@ def main():
         for threads in (1, 2):
             for label in CASES:
                 res.setdefault((label, threads), []).append(run(label, threads, a.steps))
-    us = {}
-    for (label, threads), rows in sorted(res.items()):
-        us[(label, threads)] = per_particle_step(rows)
-        r = rows[0]
-        print(f"{label:20s} {threads} thread(s): {r['n']} particles, {r['steps']} steps, "
-              f"{statistics.median(x['wall'] for x in rows):.2f} s, {us[(label, threads)]:.3f} us/particle-step, "
-              f"{statistics.median(x['pairs_per_s'] for x in rows):.3g} neighbour pairs/s")
+    us = print_per_particle_step(res)
     peak = peak_gflops()
     for label in CASES:
-        for threads in (1, 2):
-            print(median_run_line(res[(label, threads)], peak, f"{label}, {threads} thread(s)"))
-        print(f"{label}: 1 -> 2 threads {us[(label, 1)] / us[(label, 2)]:.2f}x")
+        print_thread_scaling(res, label, us, peak)
     for threads in (1, 2):
         steps, hours, total = projected_hours(res[("fountain paper", threads)])
         print(f"projected paper fountain, {threads} thread(s): {steps} steps x "
