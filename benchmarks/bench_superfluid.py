@@ -11,7 +11,7 @@ neighbour pairs per second and the roofline line of the median run:
 
 Then the projected wall time of the thesis-sized fountain (docs/superfluid.md, "Cost of
 the paper preset"): steps = ceil(t_end / dt) with t_end = 0.3 s and the preset's dt
-(221 239 steps), T_power = steps x particles x (time per particle-step), three powers.
+(221 199 steps), T_power = steps x particles x (time per particle-step), three powers.
 It assumes the cost per particle-step of the first ``--steps`` steps holds for the whole
 run (the jet adds no particles; the neighbour count per particle changes little).
 
