@@ -9,7 +9,8 @@ under half an hour on 2 cores; not timed).  Each figure goes to a folder named a
   around 1.65 and 1.9 K.  The thesis plots Donnelly-Barenghi data that it does not print;
   none is shipped here, so only the model's lines are drawn (``fig3_1.png``);
 * ``fig3_2``: left, the entropy error against A, a line per N (M = 50); right, the energy
-  error against M, a line per A (``fig3_2.png``, numbers in ``fig3_2.json``);
+  error against M, a line per A, with its log-log slope (``fig3_2.png``, numbers in
+  ``fig3_2.json``);
 * ``fig3_3``: s - s0 at (L/4, L/4) against eq. 3.51, A = 0.01, M = 50, the finest N;
 * ``fig3_4``: the fountain's particles by type (no run needed);
 * ``fig3_5``: the jet speed over time against eqs. 3.56-3.57 (60 and 80 W/m);
@@ -25,6 +26,8 @@ import os
 import sys
 
 import numpy as np
+
+from sphgen.applications.second_sound import loglog_slope
 
 from .tasks import SphgenProblem, Simulation
 
@@ -115,7 +118,7 @@ def fig3_2(sim_dir, out_dir, cfg):
     """Entropy error against A per N (M = 50); energy error against M per A (N = energy_N)."""
     plt = _plt()
     fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4))
-    data = {"entropy_error": {}, "energy_error": {}}
+    data = {"entropy_error": {}, "energy_error": {}, "energy_slope": {}}
     for N in cfg["N"]:
         pts = [[A, r["entropy_error"]] for A in cfg["A"]
                if (r := _json(os.path.join(sim_dir, ss_name(N, A, M_ENTROPY)), "results.json"))]
@@ -131,7 +134,11 @@ def fig3_2(sim_dir, out_dir, cfg):
         data["energy_error"][f"{A:g}"] = pts
         if pts:
             M, e = np.array(pts).T
-            b.plot(np.log10(1 / M), np.log10(e), "o-", label=f"A = {A:g}")
+            label = f"A = {A:g}"
+            if len(pts) > 1:   # the log-log slope of the energy error against M (issue 13)
+                data["energy_slope"][f"{A:g}"] = slope = loglog_slope(M, e)
+                label += f", slope {slope:.2f}"
+            b.plot(np.log10(1 / M), np.log10(e), "o-", label=label)
     b.set_xlabel("log10(1/M)")
     b.set_ylabel("log10 max |E - E0|/E0")
     b.set_title(f"energy error, N = {cfg['energy_N']}")

@@ -32,6 +32,26 @@ def per_particle_step(rows):
     return statistics.median(r["wall"] / (r["steps"] * r["n"]) for r in rows) * 1e6
 
 
+def print_per_particle_step(res):
+    """One line per (case, threads) of res {(case, threads): [run rows]}: particles, steps,
+    median wall time, us per particle-step, neighbour pairs/s; returns {(case, threads): us}."""
+    us = {}
+    for (label, threads), rows in sorted(res.items()):
+        us[(label, threads)] = per_particle_step(rows)
+        r = rows[0]
+        pairs = f", {statistics.median(x['pairs_per_s'] for x in rows):.3g} neighbour pairs/s" if "pairs_per_s" in r else ""
+        print(f"{label:24s} {threads} thread(s): {r['n']} particles, {r['steps']} steps, "
+              f"{statistics.median(x['wall'] for x in rows):.2f} s, {us[(label, threads)]:.3f} us/particle-step{pairs}")
+    return us
+
+
+def print_thread_scaling(res, label, us, peak):
+    """The roofline line of the median run of one case at 1 and 2 threads, and its 1 -> 2 thread speed-up."""
+    for threads in (1, 2):
+        print(median_run_line(res[(label, threads)], peak, f"{label}, {threads} thread(s)"))
+    print(f"{label}: 1 -> 2 threads {us[(label, 1)] / us[(label, 2)]:.2f}x")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
@@ -60,18 +80,10 @@ def main():
                 res.setdefault((label, threads), []).append(sphgen(label, threads, a.steps))
             if py:
                 res.setdefault(("pysph solid_mech.rings", threads), []).append(pysph(threads, a.steps))
-    us = {}
-    for (label, threads), rows in sorted(res.items()):
-        us[(label, threads)] = per_particle_step(rows)
-        r = rows[0]
-        pairs = f", {statistics.median(x['pairs_per_s'] for x in rows):.3g} neighbour pairs/s" if "pairs_per_s" in r else ""
-        print(f"{label:24s} {threads} thread(s): {r['n']} particles, {r['steps']} steps, "
-              f"{statistics.median(x['wall'] for x in rows):.2f} s, {us[(label, threads)]:.3f} us/particle-step{pairs}")
+    us = print_per_particle_step(res)
     peak = peak_gflops()
     for label in CASES:
-        for threads in (1, 2):
-            print(median_run_line(res[(label, threads)], peak, f"{label}, {threads} thread(s)"))
-        print(f"{label}: 1 -> 2 threads {us[(label, 1)] / us[(label, 2)]:.2f}x")
+        print_thread_scaling(res, label, us, peak)
         for threads in (1, 2):
             if ("pysph solid_mech.rings", threads) in us:
                 print(f"PySPH rings / {label}, {threads} thread(s): "

@@ -63,6 +63,7 @@ def test_figures_from_finished_runs(tmp_path):
     assert s["fig3_2"]["entropy_error"]["25"] == [[0.01, pytest.approx(0.014)]]
     assert len(s["fig3_2"]["entropy_error"]["50"]) == 2
     assert s["fig3_2"]["energy_error"]["0.01"] == [[10, pytest.approx(0.01)], [25, pytest.approx(0.0016)]]
+    assert s["fig3_2"]["energy_slope"]["0.01"] == pytest.approx(-2.0)
     assert set(s["fig3_5"]) == {60, 80}
     for k in range(1, 9):
         assert os.path.getsize(out / f"fig3_{k}" / f"fig3_{k}.png") > 5000, k
