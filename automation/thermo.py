@@ -134,6 +134,30 @@ def history(folder):
     return {k: rows[:, i] for i, k in enumerate(h["columns"])}
 
 
+def probe_convergence(folders, columns):
+    """Relative L2-in-time differences of probe curves between successive levels (folders
+    coarsest first; missing runs skipped): {column: [d(level k, level k+1) ...]} and
+    ``converging`` = the two finest closer than the two coarsest for every column."""
+    from sphgen.applications._thermo_solid import relative_l2_in_time
+    hs = [h for h in map(history, folders) if h is not None]
+    out = {"levels": len(hs)}
+    if len(hs) < 3:
+        return out
+    for col in columns:
+        out[col] = [relative_l2_in_time(f["t"], f[col], c["t"], c[col]) for c, f in zip(hs, hs[1:])]
+    out["converging"] = all(out[col][-1] < out[col][0] for col in columns)
+    return out
+
+
+def forms_gap(folder_E, folder_eta, columns):
+    """Relative L2-in-time gap of probe curves between the E and eta forms (None if missing)."""
+    from sphgen.applications._thermo_solid import relative_l2_in_time
+    hE, hn = history(folder_E), history(folder_eta)
+    if hE is None or hn is None:
+        return None
+    return {col: relative_l2_in_time(hE["t"], hE[col], hn["t"], hn[col]) for col in columns}
+
+
 def snapshots(folder, prefix, times):
     """{time: (ParticleArray 'body', its time) or None}: the output file nearest each time."""
     from sphgen import io
@@ -168,12 +192,14 @@ def scatter3d(fig, ax, pa, field, title, view=(25, -60), cmap=None):
     """The particles at their current positions coloured by ``field``."""
     c = _field(pa, field)
     size = float(np.clip(4000.0 / max(pa.n, 1), 0.3, 20.0))
-    sc = ax.scatter(pa.x, pa.y, pa.z, c=c, s=size, cmap=cmap or ("coolwarm" if field == "p" else "inferno"))
+    lo, hi = np.percentile(c, [1, 99])        # a few held or edge particles do not set the scale
+    sc = ax.scatter(pa.x, pa.y, pa.z, c=c, s=size, vmin=lo, vmax=hi,
+                    cmap=cmap or ("coolwarm" if field == "p" else "inferno"))
     ax.view_init(*view)
     ax.set_box_aspect((np.ptp(pa.x) or 1.0, np.ptp(pa.y) or 1.0, np.ptp(pa.z) or 1.0))
     ax.set_title(title, fontsize=8)
     ax.tick_params(labelsize=6)
-    fig.colorbar(sc, ax=ax, shrink=0.6, label=LABELS[field])
+    fig.colorbar(sc, ax=ax, shrink=0.6, label=LABELS[field] + " (1-99 %)", extend="both")
 
 
 def snapshot_figure(out_dir, name, rows, suptitle, view=(25, -60)):
@@ -195,9 +221,8 @@ def snapshot_figure(out_dir, name, rows, suptitle, view=(25, -60)):
             shown[f"{label} {field} {t:g}"] = {"t": t_file, "min": float(_field(pa, field).min()),
                                                "max": float(_field(pa, field).max())}
     fig.suptitle(suptitle, fontsize=10)
-    folder = _save(fig, out_dir, name)
-    from sphgen import io
-    io.write_json(os.path.join(folder, name + ".json"), shown)
+    _save(fig, out_dir, name)
+    _dump(out_dir, name, shown)
     return shown
 
 
@@ -257,6 +282,12 @@ def sketch(out_dir, name, app_name, args, roles, suptitle, view=(25, -60)):
     return pa.n
 
 
+def _dump(out_dir, name, data):
+    from sphgen import io
+    os.makedirs(os.path.join(out_dir, name), exist_ok=True)
+    io.write_json(os.path.join(out_dir, name, name + ".json"), data)
+
+
 def _has(pa, prop):
     return pa.has(prop) if hasattr(pa, "has") else prop in pa.data
 
@@ -302,9 +333,8 @@ def ablation_figure(out_dir, name, runs, suptitle, free_from=0.0):
         else:
             ax.text(0.5, 0.5, "not run", ha="center", transform=ax.transAxes)
     fig.suptitle(suptitle, fontsize=9)
-    folder = _save(fig, out_dir, name)
-    from sphgen import io
-    io.write_json(os.path.join(folder, name + ".json"), data)
+    _save(fig, out_dir, name)
+    _dump(out_dir, name, data)
     return data
 
 
@@ -387,9 +417,8 @@ def fig3(sim_dir, out_dir, cfg):
         ax.set_ylabel("L2 error (inner cube)")
         ax.set_title(what, fontsize=8)
     fig.suptitle("Fig. 3: sphgen only (the paper's Upwind-VCFVM curves are not available); t = 0.001 s", fontsize=9)
-    folder = _save(fig, out_dir, "fig3")
-    from sphgen import io
-    io.write_json(os.path.join(folder, "fig3.json"), data)
+    _save(fig, out_dir, "fig3")
+    _dump(out_dir, "fig3", data)
     return data
 
 
@@ -428,6 +457,9 @@ def lblock_figures(sim_dir, out_dir, cfg):
                   [("(a) v at X = [0, 10, 0]", [(f"probe_v{c}", f"v_{c}") for c in "xyz"], "v [m/s]"),
                    ("(b) u at X = [0, 10, 0]", [(f"probe_u{c}", f"u_{c}") for c in "xyz"], "u [m]")],
                   "Fig. 7: probe, the three finest levels, sphgen only (no Upwind-VCFVM curves available)")
+    n["fig7"] = probe_convergence([os.path.join(sim_dir, f"lblock_dx{_dx_label(dx)}") for dx in levels],
+                                  [f"probe_{q}{c}" for q in "vu" for c in "xyz"])
+    _dump(out_dir, "fig7", n["fig7"])
     series_figure(out_dir, "fig8", [(f"dx={_dx_label(levels[-1])}", fine, "-")], MOMENTA_PANELS,
                   "Fig. 8: momenta, energies, entropy (finest level)")
     snapshot_figure(out_dir, "fig9", [(fine, "l_block", "theta", LBLOCK_TIMES["fig9_theta"], "theta"),
@@ -462,6 +494,11 @@ def disk_figures(sim_dir, out_dir, cfg):
                   [("(a) v_Z at X = [2, 4, 0]", [("probe_vz", "")], "v_Z [m/s]"),
                    ("(b) theta at X = [2, 4, 0]", [("probe_theta", "")], "theta [K]")],
                   "Fig. 12: E-form (solid) and eta-form (dashed), every level")
+    out["fig12"] = {"convergence": {form: probe_convergence([run(form, dx) for dx in levels],
+                                                            ["probe_vz", "probe_theta"]) for form in ("E", "eta")},
+                    "E_vs_eta": {_dx_label(dx): forms_gap(run("E", dx), run("eta", dx), ["probe_vz", "probe_theta"])
+                                 for dx in levels}}
+    _dump(out_dir, "fig12", out["fig12"])
     series_figure(out_dir, "fig13", [(f"dx={_dx_label(levels[-1])}", fine, "-")], MOMENTA_PANELS,
                   "Fig. 13: momenta, energies, entropy (finest level, E-form)")
     snapshot_figure(out_dir, "fig14", [(fine, "thermo_disk", "theta", DISK_TIMES["fig14_theta"], "theta"),
@@ -498,6 +535,11 @@ def punch_figures(sim_dir, out_dir, cfg):
                   [("(a) v_Z at X = [0, 1, 1]", [("probe_vz", "")], "v_Z [m/s]"),
                    ("(b) P_11 at X = [0, 1, 1]", [("probe_P11", "")], "P_11 [Pa]")],
                   "Fig. 18: E-form (solid) and eta-form (dashed), every level")
+    out["fig18"] = {"convergence": {form: probe_convergence([run("full", form, dx) for dx in levels],
+                                                            ["probe_vz", "probe_P11"]) for form in ("E", "eta")},
+                    "E_vs_eta": {_dx_label(dx): forms_gap(run("full", "E", dx), run("full", "eta", dx),
+                                                          ["probe_vz", "probe_P11"]) for dx in levels}}
+    _dump(out_dir, "fig18", out["fig18"])
     snapshot_figure(out_dir, "fig19", [(run("full", "E", mid), "thermo_punch", "theta", PUNCH_TIMES["fig19"],
                                         "theta (top view)"),
                                        (run("full", "E", mid), "thermo_punch", "p", PUNCH_TIMES["fig19"], "p")],

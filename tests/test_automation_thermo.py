@@ -43,12 +43,13 @@ def test_problems_have_distinct_names_and_commands(tmp_path):
     assert len(names) == 12 and "thermo_punch_quick" in names
 
 
-def _history(folder, n=21, tf=1.0):
+def _history(folder, n=21, tf=1.0, err=0.0):
+    """Smooth curves plus ``err`` times a bump (a level's error)."""
     t = np.linspace(0, tf, n)
     rows = np.zeros((n, len(COLUMNS)))
     rows[:, 0] = t
     for k, c in enumerate(COLUMNS[1:], 1):
-        rows[:, k] = np.sin(t * k) + k
+        rows[:, k] = np.sin(t * k) + k + err * np.cos(t)
     with open(os.path.join(folder, "history.json"), "w") as f:
         json.dump({"columns": list(COLUMNS), "rows": rows.tolist()}, f)
 
@@ -63,10 +64,10 @@ def _snapshots(folder, prefix, times):
         io.write(os.path.join(folder, f"{prefix}_{step:06d}.h5"), [pa], {"t": t, "dt": 1e-3, "step": step})
 
 
-def _fake(sim, name, app, results=None, times=(), tf=1.0):
+def _fake(sim, name, app, results=None, times=(), tf=1.0, err=0.0):
     folder = sim / name
     os.makedirs(folder)
-    _history(str(folder), tf=tf)
+    _history(str(folder), tf=tf, err=err)
     with open(folder / "results.json", "w") as f:
         json.dump(results or {"t": tf, "n_particles": 60, "J_min": 0.9, "energy_residual": 1e-16}, f)
     if times:
@@ -99,9 +100,15 @@ def test_every_figure_from_finished_runs(tmp_path):
     lb = thermo.lblock_figures(str(sim), str(out), cfg)
     assert lb["fig4"] > 100 and set(lb["ablation"]) == {"default (limited jumps, projection)", "raw jumps",
                                                          "no projection"}
-    for name, (app, _) in thermo.disk_cases(cfg).items():
-        _fake(sim, name, app, times=thermo._times(DISK_TIMES) if "ablation" not in name else (), tf=10.0)
-    thermo.disk_figures(str(sim), str(out), cfg)
+    eta_err = {"1": 0.0, "0.5": 0.1}                       # E: errors ~ dx^2; eta: growing
+    for name, (app, args) in thermo.disk_cases(cfg).items():
+        err = float(args[1]) ** 2 if "_E_" in name else eta_err.get(args[1], 0.3)
+        _fake(sim, name, app, times=thermo._times(DISK_TIMES) if "ablation" not in name else (), tf=10.0, err=err)
+    di = thermo.disk_figures(str(sim), str(out), cfg)
+    conv = di["fig12"]["convergence"]
+    assert conv["E"]["converging"] and not conv["eta"]["converging"] and conv["E"]["levels"] == 3
+    gap = di["fig12"]["E_vs_eta"]["0.3333"]["probe_vz"]
+    assert 0 < gap < 0.1
     snaps = {"0.07": {"R_p": 0.3}, "0.21": {"R_p": 0.2}}
     for name, (app, _) in thermo.punch_cases(cfg).items():
         _fake(sim, name, app, {"snapshots": snaps, "t": 0.4}, thermo._times(PUNCH_TIMES) if "abl" not in name else (),
