@@ -17,8 +17,9 @@ Each figure goes to a folder named after its number (``fig5/fig5.png``).  The pa
 3, 6, 7 and 17 also show the authors' in-house vertex-centred finite-volume code: those
 curves are not available, so ours alone are drawn (the titles say so).  Sketches (Figs. 1,
 4, 10, 15, 20, 23) are drawn from the applications' own particles, coloured by their role.
-The ablations (``ablation_<section>``: raw vs reconstructed jumps, the projection off) plot
-K, S and the angular-momentum drift of each variant beside the default.
+The ablations (``ablation_<section>``: raw vs reconstructed jumps, the projection off, S^E of
+eq. 76 on the disk) plot K, S and the angular-momentum drift of each variant beside the
+default; the disk's also gives the E-vs-eta probe gap with and without S^E.
 
 Snapshots are written at the figures' times (``--output-at``), so each panel is at its time.
 ``python automate.py thermo`` runs the paper preset (levels as close to the paper's counts
@@ -87,13 +88,15 @@ def lblock_cases(cfg):
 
 
 def disk_cases(cfg):
-    """Every level in the E and eta forms; ablations at the coarsest: raw jumps, no projection."""
+    """Every level in the E and eta forms; ablations at the coarsest: raw jumps, no projection,
+    S^E of eq. 76 (``--SE matched``)."""
     out_at = ["--output-at", *map(str, _times(DISK_TIMES))]
     out = {f"disk_{form}_dx{_dx_label(dx)}": ("thermo_disk", ["--dx", dx, "--form", form, *out_at])
            for dx in cfg["disk_dx"] for form in ("E", "eta")}
     dx = cfg["disk_dx"][0]
     out["disk_ablation_raw"] = ("thermo_disk", ["--dx", dx, "--jumps", "raw", "--disable-output"])
     out["disk_ablation_noproj"] = ("thermo_disk", ["--dx", dx, "--no-projection", "--disable-output"])
+    out["disk_ablation_SE"] = ("thermo_disk", ["--dx", dx, "--SE", "matched", "--disable-output"])
     return out
 
 
@@ -507,8 +510,13 @@ def disk_figures(sim_dir, out_dir, cfg):
     out["ablation"] = ablation_figure(out_dir, "ablation_disk",
                                       [("default (limited jumps, projection)", run("E", levels[0])),
                                        ("raw jumps", os.path.join(sim_dir, "disk_ablation_raw")),
-                                       ("no projection", os.path.join(sim_dir, "disk_ablation_noproj"))],
+                                       ("no projection", os.path.join(sim_dir, "disk_ablation_noproj")),
+                                       ("S^E of eq. 76", os.path.join(sim_dir, "disk_ablation_SE"))],
                                       "Disk ablations (coarsest level)")
+    out["ablation_SE_vs_eta"] = {"S^E = 0": forms_gap(run("E", levels[0]), run("eta", levels[0]),
+                                                      ["probe_vz", "probe_theta"]),
+                                 "S^E eq. 76": forms_gap(os.path.join(sim_dir, "disk_ablation_SE"), run("eta", levels[0]),
+                                                         ["probe_vz", "probe_theta"])}
     return out
 
 

@@ -102,13 +102,16 @@ def test_every_figure_from_finished_runs(tmp_path):
                                                          "no projection"}
     eta_err = {"1": 0.0, "0.5": 0.1}                       # E: errors ~ dx^2; eta: growing
     for name, (app, args) in thermo.disk_cases(cfg).items():
-        err = float(args[1]) ** 2 if "_E_" in name else eta_err.get(args[1], 0.3)
+        err = 0.05 if "ablation" in name else float(args[1]) ** 2 if "_E_" in name else eta_err.get(args[1], 0.3)
         _fake(sim, name, app, times=thermo._times(DISK_TIMES) if "ablation" not in name else (), tf=10.0, err=err)
     di = thermo.disk_figures(str(sim), str(out), cfg)
     conv = di["fig12"]["convergence"]
     assert conv["E"]["converging"] and not conv["eta"]["converging"] and conv["E"]["levels"] == 3
     gap = di["fig12"]["E_vs_eta"]["0.3333"]["probe_vz"]
     assert 0 < gap < 0.1
+    assert set(di["ablation"]) == {"default (limited jumps, projection)", "raw jumps", "no projection",
+                                   "S^E of eq. 76"}
+    assert di["ablation_SE_vs_eta"]["S^E eq. 76"]["probe_vz"] > 0
     snaps = {"0.07": {"R_p": 0.3}, "0.21": {"R_p": 0.2}}
     for name, (app, _) in thermo.punch_cases(cfg).items():
         _fake(sim, name, app, {"snapshots": snaps, "t": 0.4}, thermo._times(PUNCH_TIMES) if "abl" not in name else (),
