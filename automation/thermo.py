@@ -355,14 +355,16 @@ def fig1(out_dir):
     fig, ax = plt.subplots(figsize=(5, 5))
     ax.scatter(X[mid, 0], X[mid, 1], s=2e4 * V[mid], color="0.6", label="particles X_b (area ~ V_b)")
     inside = mid & (np.linalg.norm(X[:, :2] - a, axis=1) < 2 * hdx * dx)
-    ax.scatter(X[inside, 0], X[inside, 1], s=2e4 * V[inside], color="tab:blue", label=f"neighbours Lambda_a ({inside.sum() - 1} in this plane)")
+    ax.scatter(X[inside, 0], X[inside, 1], s=2e4 * V[inside], color="tab:blue",
+               label=f"neighbours Lambda_a ({inside.sum() - 1} in this plane)")
     ax.scatter(*a, s=60, color="tab:red", label="particle a")
     ax.add_patch(plt.Circle(a, 2 * hdx * dx, fill=False, color="tab:red", ls="--"))
     ax.set_aspect("equal")
     ax.set_xlabel("X_1 [m]")
     ax.set_ylabel("X_2 [m]")
     ax.legend(fontsize=7, loc="upper right")
-    ax.set_title(f"Fig. 1: particle approximation (our vertex lattice, n = {n}; support 2h = {2 * hdx:g} dx)", fontsize=8)
+    ax.set_title(f"Fig. 1: particle approximation (our vertex lattice, n = {n}; support 2h = {2 * hdx:g} dx)",
+                 fontsize=8)
     _save(fig, out_dir, "fig1")
 
 
@@ -398,7 +400,8 @@ def fig3(sim_dir, out_dir, cfg):
     comps = (("p_x", "p_y", "p_z"), ("P_11", "P_12", "P_22", "P_23", "P_33"), ("theta",))
     data = {}
     for (jumps, bc), style in zip(cfg["mms_cases"], ("o-", "s--", "^-.", "v:")):
-        rows = [r for n in cfg["mms_n"] if (r := _json(os.path.join(sim_dir, f"mms_{jumps}_{bc}_n{n}"), "results.json"))]
+        rows = [r for n in cfg["mms_n"]
+                if (r := _json(os.path.join(sim_dir, f"mms_{jumps}_{bc}_n{n}"), "results.json"))]
         if not rows:
             continue
         key = f"{jumps}, {bc}"
@@ -515,8 +518,8 @@ def disk_figures(sim_dir, out_dir, cfg):
                                       "Disk ablations (coarsest level)")
     out["ablation_SE_vs_eta"] = {"S^E = 0": forms_gap(run("E", levels[0]), run("eta", levels[0]),
                                                       ["probe_vz", "probe_theta"]),
-                                 "S^E eq. 76": forms_gap(os.path.join(sim_dir, "disk_ablation_SE"), run("eta", levels[0]),
-                                                         ["probe_vz", "probe_theta"])}
+                                 "S^E eq. 76": forms_gap(os.path.join(sim_dir, "disk_ablation_SE"),
+                                                         run("eta", levels[0]), ["probe_vz", "probe_theta"])}
     return out
 
 

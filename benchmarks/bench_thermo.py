@@ -32,11 +32,15 @@ def per_pair(rows):
     return statistics.median(1e9 / r["pairs_per_s"] for r in rows)
 
 
-def main():
+def options():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--steps", type=int, default=200, help="time steps per run (default %(default)s)")
-    a = ap.parse_args()
+    ap.add_argument("--repeat", type=int, default=3, help="runs per case, interleaved (default %(default)s)")
+    return ap.parse_args()
+
+
+def main():
+    a = options()
     print(f"load average before: {os.getloadavg()[0]:.2f}")
     work = tempfile.mkdtemp(prefix="sphgen_thermo_")
 
