@@ -15,7 +15,7 @@ unit reference volume: ``tint`` is the internal force T_a / V_a (eq. 55), ``aF``
 The dissipation (eqs. 66, 72-75) is S_ab times the jump of an entropy variable: v/Xi and
 Sigma_J/Xi in the E-form (Xi = theta/theta_R), v and Sigma_J in the eta-form; S^eta = 0
 and S^E = 0 or (``se``) eq. 76, guarded.  ``reconstruct`` replaces the raw jump by a
-limited linear reconstruction (module ``docs/thermo.md``): exact zero for linear fields, and raw x used >= 0 per component so
+limited linear reconstruction (docs/thermo.md): zero for linear fields, and raw x used >= 0 per component so
 the semi-discrete entropy inequality is kept.
 """
 from math import fabs, log, sqrt  # noqa: F401  (the Python evaluator's math)
