@@ -368,26 +368,34 @@ def fig1(out_dir):
     _save(fig, out_dir, "fig1")
 
 
-def fig2(out_dir, n=10):
-    """(a) the cube's particles, those with exact data (buffer 4h) marked; (b) |v| and (c)
-    theta at t = 0 from the exact fields (eqs. 84-88)."""
+def fig2(out_dir, n=10, n_data=20):
+    """(a) the plane X_3 = 1/2 of the coarsest level (n_data): particles with exact data (the
+    4h buffer), the interior, the inner cube where errors are measured; (b) |v| and (c)
+    theta at t = 0 from the exact fields (eqs. 84-88) on an n^3 lattice."""
     from sphgen.applications.thermo_mms import PAPER, Manufactured, vertex_cube
     from sphgen.equations.thermo_materials import LinearThermoElastic
     plt = _plt()
-    X, _ = vertex_cube(n)
     ex = Manufactured(LinearThermoElastic(**PAPER))
-    d = np.minimum(X, 1.0 - X).min(axis=1)
-    fixed = d < 4.0 * 1.2 / n
     fig = plt.figure(figsize=(14, 4.2))
-    panels = ((fixed.astype(float), "(a) exact data (buffer 4h) / interior", "coolwarm"),
-              (np.linalg.norm(ex.velocity(X), axis=1), "(b) |v| at t = 0 [m/s]", "viridis"),
-              (ex.temperature(X, 0.0), "(c) theta at t = 0 [K]", "inferno"))
-    for k, (c, title, cmap) in enumerate(panels):
-        ax = fig.add_subplot(1, 3, k + 1, projection="3d")
+    Xd, _ = vertex_cube(n_data)
+    Xd = Xd[np.abs(Xd[:, 2] - 0.5) < 1e-9]
+    buffer = np.minimum(Xd, 1.0 - Xd).min(axis=1) < 4.0 * 1.2 / n_data
+    inner = np.all((Xd >= 0.25 - 1e-9) & (Xd <= 0.75 + 1e-9), axis=1)
+    ax = fig.add_subplot(1, 3, 1)
+    for mask, color, label in ((buffer, "tab:red", "exact p, theta (4h buffer)"), (~buffer & ~inner, "0.6", "free"),
+                               (inner, "tab:blue", "free, errors measured (inner cube)")):
+        ax.scatter(Xd[mask, 0], Xd[mask, 1], s=8, color=color, label=f"{label} ({mask.sum()})")
+    ax.set_aspect("equal")
+    ax.legend(fontsize=6, loc="upper right")
+    ax.set_title(f"(a) plane X_3 = 1/2, n = {n_data} (--bc buffer)", fontsize=8)
+    X, _ = vertex_cube(n)
+    for k, (c, title, cmap) in enumerate(((np.linalg.norm(ex.velocity(X), axis=1), "(b) |v| at t = 0 [m/s]", "viridis"),
+                                          (ex.temperature(X, 0.0), "(c) theta at t = 0 [K]", "inferno"))):
+        ax = fig.add_subplot(1, 3, k + 2, projection="3d")
         sc = ax.scatter(X[:, 0], X[:, 1], X[:, 2], c=c, s=6, cmap=cmap)
         ax.set_title(title, fontsize=8)
         fig.colorbar(sc, ax=ax, shrink=0.6)
-    fig.suptitle(f"Fig. 2: manufactured solution on the unit cube (our lattice n = {n})", fontsize=9)
+    fig.suptitle("Fig. 2: manufactured solution on the unit cube (our lattices)", fontsize=9)
     _save(fig, out_dir, "fig2")
 
 
