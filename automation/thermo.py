@@ -319,7 +319,7 @@ def ablation_figure(out_dir, name, runs, suptitle, free_from=0.0):
         if h is None:
             continue
         A = np.stack([h["A_x"], h["A_y"], h["A_z"]], 1)
-        k = int(np.searchsorted(h["t"], free_from - 1e-12))
+        k = min(int(np.searchsorted(h["t"], free_from - 1e-12)), len(h["t"]) - 1)
         drift = np.linalg.norm(A - A[k], axis=1) / max(np.linalg.norm(A[k]), 1e-300)
         axes[0].plot(h["t"], h["kinetic"], lw=1, label=label)
         axes[1].plot(h["t"], h["entropy"] - h["entropy"][0], lw=1, label=label)

@@ -86,20 +86,27 @@ def _mms(sim, cfg):
 
 
 @pytest.mark.filterwarnings("ignore")
-def test_every_figure_from_finished_runs(tmp_path):
+def test_mms_disk_and_gripper_figures_from_finished_runs(tmp_path):
+    """Every kind of figure (sketch, 3-D snapshots, series, ablation, Fig. 3's orders, the
+    convergence and E-vs-eta measures) on three sections; the slow test draws all 24."""
     cfg = CONFIG["quick"]
     sim, out = tmp_path / "sim", tmp_path / "fig"
     _mms(sim, cfg)
     mms = thermo.mms_figures(str(sim), str(out), cfg)
     assert mms["fig3"]["limited, buffer"]["orders"]["P_12"] == pytest.approx(2.0)
     assert mms["fig3"]["raw, surface"]["orders"]["theta"] == pytest.approx(1.0)
-    lt = thermo._times(LBLOCK_TIMES)
-    for name, (app, _) in thermo.lblock_cases(cfg).items():
-        if name != "lblock_dx1":           # a missing run: its panels say "not run"
-            _fake(sim, name, app, times=lt if "ablation" not in name else (), tf=40.0)
-    lb = thermo.lblock_figures(str(sim), str(out), cfg)
-    assert lb["fig4"] > 100 and set(lb["ablation"]) == {"default (limited jumps, projection)", "raw jumps",
-                                                         "no projection"}
+    _disk(sim, out, cfg)
+    for name, (app, _) in thermo.gripper_cases(cfg).items():
+        _fake(sim, name, app, times=thermo._times(GRIPPER_TIMES), tf=0.5)
+    thermo.gripper_figures(str(sim), str(out), cfg)
+    for k in (1, 2, 3, 10, 11, 12, 13, 14, 20, 21, 22):
+        assert os.path.getsize(out / f"fig{k}" / f"fig{k}.png") > 5000, k
+    assert os.path.getsize(out / "ablation_disk" / "ablation_disk.png") > 5000
+    with open(out / "fig14" / "fig14.json") as f:
+        assert json.load(f)["theta theta 4.5"]["t"] == 4.5     # the panel is at its time (--output-at)
+
+
+def _disk(sim, out, cfg):
     eta_err = {"1": 0.0, "0.5": 0.1}                       # E: errors ~ dx^2; eta: growing
     for name, (app, args) in thermo.disk_cases(cfg).items():
         err = 0.05 if "ablation" in name else float(args[1]) ** 2 if "_E_" in name else eta_err.get(args[1], 0.3)
@@ -112,6 +119,25 @@ def test_every_figure_from_finished_runs(tmp_path):
     assert set(di["ablation"]) == {"default (limited jumps, projection)", "raw jumps", "no projection",
                                    "S^E of eq. 76"}
     assert di["ablation_SE_vs_eta"]["S^E eq. 76"]["probe_vz"] > 0
+
+
+@pytest.mark.slow
+@pytest.mark.filterwarnings("ignore")
+def test_every_figure_from_finished_runs(tmp_path):
+    cfg = CONFIG["quick"]
+    sim, out = tmp_path / "sim", tmp_path / "fig"
+    _mms(sim, cfg)
+    thermo.mms_figures(str(sim), str(out), cfg)
+    lt = thermo._times(LBLOCK_TIMES)
+    for name, (app, _) in thermo.lblock_cases(cfg).items():
+        if name != "lblock_dx1":           # a missing run: its panels say "not run"
+            _fake(sim, name, app, times=lt if "ablation" not in name else (), tf=40.0)
+    _fake(sim, "lblock_short", "l_block", tf=2.0)        # ended before the load did
+    lb = thermo.lblock_figures(str(sim), str(out), cfg)
+    assert lb["fig4"] > 100 and set(lb["ablation"]) == {"default (limited jumps, projection)", "raw jumps",
+                                                         "no projection"}
+    thermo.ablation_figure(str(out), "ablation_short", [("short", str(sim / "lblock_short"))], "", free_from=5.0)
+    _disk(sim, out, cfg)
     snaps = {"0.07": {"R_p": 0.3}, "0.21": {"R_p": 0.2}}
     for name, (app, _) in thermo.punch_cases(cfg).items():
         _fake(sim, name, app, {"snapshots": snaps, "t": 0.4}, thermo._times(PUNCH_TIMES) if "abl" not in name else (),
