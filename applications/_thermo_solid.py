@@ -60,16 +60,32 @@ class ThermoSolid(Application):
         else:
             group.add_argument("--projection", dest="projection", action="store_true",
                                help="switch the angular-momentum projection (eqs. 79-82) on")
+        group.add_argument("--SE", dest="se", choices=("zero", "matched"), default="zero",
+                           help="E-form temperature dissipation S^E: zero (default; S^E = 0) or matched "
+                                "(eq. 76, guarded: 0 at equal temperatures and for a negative bracket, "
+                                "capped at the pair's conductance; docs/thermo.md)")
         group.add_argument("--cfl", type=float, default=0.3, help="alpha_CFL of eq. 78 (default %(default)s)")
         group.add_argument("--perturb", type=float, default=0.0,
                            help="random perturbation of the reference lattice in units of dx (default 0)")
         group.add_argument("--seed", type=int, default=1, help="seed of the perturbation (default 1)")
+        group.add_argument("--output-at", type=float, nargs="+", default=(), metavar="T",
+                           help="also write the particles at these times (the step is shortened to hit "
+                                "each; for the figures' snapshots)")
 
     def check_scheme_options(self, o):
         if not (np.isfinite(o.perturb) and 0 <= o.perturb < 0.5):
             raise InputError(f"--perturb must be in [0, 0.5), got {o.perturb}")
+        if not all(np.isfinite(t) and t >= 0 for t in o.output_at):
+            raise InputError(f"--output-at times must be finite and >= 0, got {o.output_at}")
+        if o.se == "matched" and o.form != "E":
+            raise InputError("--SE matched belongs to the E-form (--form E)")
         if o.variant == "reduced" and o.form != "E":
             raise InputError("--variant reduced is an E-form scheme (--form E)")
+
+    def _solver(self, integrator, dt):
+        solver = super()._solver(integrator, dt)
+        solver.output_at_times = sorted(t for t in self.options.output_at if 0 < t <= self.options.tf)
+        return solver
 
     def perturbed(self, x, y, z, dx):
         """The lattice moved by --perturb dx at random (the volumes stay)."""
@@ -81,7 +97,8 @@ class ThermoSolid(Application):
     def make_scheme(self, material, dx):
         o = self.options
         return ThermoUpwindScheme(["body"], material, dx, hdx=o.hdx, kernel=o.kernel, form=o.form,
-                                  jumps=o.jumps, projection=o.projection, cfl=o.cfl, **VARIANTS[o.variant])
+                                  jumps=o.jumps, projection=o.projection, cfl=o.cfl, se=o.se,
+                                  **VARIANTS[o.variant])
 
     def set_probe(self, X):
         """The particle (its gid: the creation index; sorting moves particles in memory) nearest
@@ -111,7 +128,8 @@ class ThermoSolid(Application):
 
     def history_meta(self):
         o = self.options
-        return {"dx": self.dx, "variant": o.variant, "jumps": o.jumps, "form": o.form, "projection": o.projection,
+        return {"dx": self.dx, "variant": o.variant, "jumps": o.jumps, "form": o.form, "se": o.se,
+                "projection": o.projection,
                 "hdx": o.hdx, "kernel": o.kernel, "cfl": o.cfl, "perturb": o.perturb, "seed": o.seed,
                 "probe_X": list(self.probe_point), **self.case_meta()}
 

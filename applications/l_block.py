@@ -138,4 +138,5 @@ class LBlock(ThermoSolid):
                                {"ballistic_rise": b["ballistic_rise"], "ballistic_drop": b["ballistic_drop"]})
         print(f"l_block: N={r['n_particles']} t={self.solver.t:.4g} ({self.options.variant}): |dL|/sum V|p| "
               f"{r['L_drift']:.2e}, |dA|/|A| after the load {r['A_drift']}, energy residual "
-              f"{r['energy_residual']:.2e}, S fall {r['entropy_fall']:.2e}, B rise {r['ballistic_rise']:.2e}")
+              f"{r['energy_residual']:.2e}, S fall {r['entropy_fall']}, B rise {r['ballistic_rise']} "
+              f"(None: the run ended before the load did)")

@@ -13,9 +13,9 @@ unit reference volume: ``tint`` is the internal force T_a / V_a (eq. 55), ``aF``
 (f_R + A_R t_B / V) and heat supply ``sb`` (s_R - A_R Q_B / V).
 
 The dissipation (eqs. 66, 72-75) is S_ab times the jump of an entropy variable: v/Xi and
-Sigma_J/Xi in the E-form (Xi = theta/theta_R), v and Sigma_J in the eta-form; S^E = S^eta
-= 0.  ``reconstruct`` replaces the raw jump by a limited linear reconstruction (module
-``docs/thermo.md``): exact zero for linear fields, and raw x used >= 0 per component so
+Sigma_J/Xi in the E-form (Xi = theta/theta_R), v and Sigma_J in the eta-form; S^eta = 0
+and S^E = 0 or (``se``) eq. 76, guarded.  ``reconstruct`` replaces the raw jump by a
+limited linear reconstruction (docs/thermo.md): zero for linear fields, and raw x used >= 0 per component so
 the semi-discrete entropy inequality is kept.
 """
 from math import fabs, log, sqrt  # noqa: F401  (the Python evaluator's math)
@@ -207,10 +207,12 @@ class UpwindFluxes(Equation):
     ``reduced`` drops the J equation (J = det F);
     ``volumetric``: D_J on the jump of the mean stress SD, applied as the isotropic rate
     delta = sum_b D_J^ab / V to J, F and H together (J += delta, F += delta F / 3J,
-    H += 2 delta H / 3J), so that J stays det F (not the paper's; docs/thermo.md).
+    H += 2 delta H / 3J), so that J stays det F (not the paper's; docs/thermo.md);
+    ``se`` 1 adds D_E^ab = S^E_ab (1/Xi_a - 1/Xi_b) of eq. 66 with S^E of eq. 76 (E-form;
+    guarded and capped, docs/thermo.md), 0 keeps S^E = 0.
     """
 
-    switches = ("form", "reconstruct", "reduced", "dissipation", "external", "volumetric")
+    switches = ("form", "reconstruct", "reduced", "dissipation", "external", "volumetric", "se")
 
     def initialize(self, d_idx, d_tint, d_aF, d_aJ, d_aE, d_aeta):
         for k in range(3):
@@ -333,6 +335,29 @@ class UpwindFluxes(Equation):
                     d_tint[3 * d_idx + k] += f * (cp * jn * csk[k] + cs * used[k])
                 if not self.reduced and self.dissipation == 1:
                     d_aJ[d_idx] += nc * nc / (2.0 * rho * cp * nC) * js
+                if self.se == 1 and self.form == 0:
+                    # S^E of eq. 76 from the raw jumps, guarded (docs/thermo.md): 0 where
+                    # 1/Xi_a = 1/Xi_b (0/0) or where the bracket is negative, capped at the
+                    # pair's conductance theta_R k ||C^Skew|| / |X_a - X_b|
+                    dxi = ra - rb
+                    if fabs(dxi) > 1e-12 * ra:
+                        for k in range(3):
+                            rec[k] = vbb[k] - va[k]
+                            used[k] = vbb[k] * rb - va[k] * ra
+                        rn = dot3(rec, csk)
+                        jn = dot3(used, csk)
+                        brk = f * (cp * rn * rn + cs * (dot3(rec, rec) - rn * rn)) - f * (
+                            cp * jn * jn + cs * (dot3(used, used) - jn * jn))
+                        if not self.reduced and self.dissipation == 1:
+                            rs = s_SD[s_idx] - d_SD[d_idx]
+                            js = s_SD[s_idx] * rb - d_SD[d_idx] * ra
+                            brk += nc * nc / (2.0 * rho * cp * nC) * (rs * rs - js * js)
+                        if brk > 0.0:
+                            sE = brk / (dxi * dxi)
+                            cap = d_mat[7] * d_mat[9] * nC / sqrt(dot3(XIJ, XIJ))
+                            if sE > cap:
+                                sE = cap
+                            d_aE[d_idx] += sE * dxi
 
     def post_loop(self, d_idx, d_V, d_F, d_H, d_J, d_u, d_v, d_w, d_theta, d_Q, d_gradT, d_fb, d_sb,
                   d_tint, d_aF, d_aH, d_aJ, d_aE, d_aeta):

@@ -309,7 +309,7 @@ class ThermoUpwindScheme(Scheme):
     dim = 3
 
     def __init__(self, bodies, material, dx, hdx=1.2, kernel="wendland", form="E", reduced=False,
-                 jumps="raw", projection=False, dissipation=True, cfl=0.3, dt=None, dj="paper"):
+                 jumps="raw", projection=False, dissipation=True, cfl=0.3, dt=None, dj="paper", se="zero"):
         if not isinstance(material, ThermoElasticMaterial):
             raise InputError(f"ThermoUpwindScheme: material must be a ThermoElasticMaterial, got {material!r}")
         if form not in FORMS:
@@ -320,6 +320,10 @@ class ThermoUpwindScheme(Scheme):
             raise InputError(f"ThermoUpwindScheme: dj {dj!r} must be 'paper' or 'volumetric'")
         if dj == "volumetric" and reduced:
             raise InputError("ThermoUpwindScheme: dj='volumetric' needs the J equation (reduced=False)")
+        if se not in ("zero", "matched"):
+            raise InputError(f"ThermoUpwindScheme: se {se!r} must be 'zero' or 'matched'")
+        if se == "matched" and form != "E":
+            raise InputError("ThermoUpwindScheme: S^E (se='matched', eq. 76) belongs to the E-form")
         if jumps not in JUMPS:
             raise InputError(f"ThermoUpwindScheme: jumps {jumps!r} must be one of {', '.join(JUMPS)}")
         for name, v in (("dx", dx), ("hdx", hdx), ("cfl", cfl), ("dt", 1.0 if dt is None else dt)):
@@ -336,6 +340,7 @@ class ThermoUpwindScheme(Scheme):
         self.projection, self.cfl = bool(projection), float(cfl)
         self.dissipation = 2 if dissipation == "p" else int(bool(dissipation))
         self.volumetric = int(dj == "volumetric")
+        self.se = int(se == "matched")
         self.dt = None if dt is None else float(dt)
         self.adaptive_dt = (("dt_cfl",), self.cfl) if dt is None else None
         self.loads = []
@@ -418,7 +423,7 @@ class ThermoUpwindScheme(Scheme):
             rates += [Group([EntropyVariableGradients(b, [b], form=form, reconstruct=rec)], reference=True),
                       Group([UpwindFluxes(b, [b], form=form, reconstruct=rec, reduced=red,
                                           dissipation=self.dissipation, external=ext,
-                                          volumetric=self.volumetric)], reference=True)]
+                                          volumetric=self.volumetric, se=self.se)], reference=True)]
             if self.projection:
                 rates.append(Group([AngularMomentumProjection(b)]))
             vol = self.volumetric

@@ -488,3 +488,77 @@ def test_projection_in_the_scene_zeroes_the_sums_of_forces_and_torques():
                             np.abs((pa.V[:, None] * np.cross(x, t)).sum(0)).max() / scale)
     assert sums[False][1] > 1e-6
     assert max(sums[True]) < 1e-14, sums
+
+
+# ---------------------------------------------------------------------- S^E (eq. 76)
+def _se_pairs(s, sc, pa):
+    """(a, DE per ordered pair, S^E, bracket, dxi) recomputed in numpy: eq. 76 from the raw
+    jumps, 0 where 1/Xi_a = 1/Xi_b or the bracket is negative, capped at theta_R k ||C^Skew||
+    / |X_a - X_b|."""
+    a, b, Cab, Cba = pair_geometry(s, sc, pa)
+    thR, H = s.material.theta_R, tensors(pa, "H")
+    Csk = 0.5 * (Cab - Cba)
+    csk = 0.5 * (np.einsum("pij,pj->pi", H[a], Cab) - np.einsum("pij,pj->pi", H[b], Cba))
+    nC, nc = np.linalg.norm(Csk, axis=1), np.linalg.norm(csk, axis=1)
+    nn = csk / nc[:, None]
+    rho, cp, cs = 0.5 * (pa.rho[a] + pa.rho[b]), 0.5 * (pa.cp[a] + pa.cp[b]), 0.5 * (pa.cs[a] + pa.cs[b])
+
+    def quad(w):   # w . S^p w (eqs. 73-74)
+        wn = np.einsum("pi,pi->p", w, nn)
+        return 0.5 * rho * nC * (cp * wn * wn + cs * (np.einsum("pi,pi->p", w, w) - wn * wn))
+
+    SJ = nc * nc / (2 * rho * cp * nC)
+    vel, r = np.stack([pa.u, pa.v, pa.w], 1), thR / pa.theta
+    d_eta = quad(vel[b] - vel[a]) + SJ * (pa.SJ[b] - pa.SJ[a]) ** 2                                 # (71)
+    d_E = quad(vel[b] * r[b, None] - vel[a] * r[a, None]) + SJ * (pa.SJ[b] * r[b] - pa.SJ[a] * r[a]) ** 2
+    dxi = r[a] - r[b]
+    bracket = d_eta - d_E
+    X = np.stack([pa.x0, pa.y0, pa.z0], 1)
+    cap = thR * s.material.k_th * nC / np.linalg.norm(X[a] - X[b], axis=1)
+    ok = (np.abs(dxi) > 1e-12 * r[a]) & (bracket > 0)
+    SE = np.where(ok, np.minimum(np.where(ok, bracket, 0.0) / np.where(ok, dxi, 1.0) ** 2, cap), 0.0)
+    return a, SE * dxi, SE, bracket, dxi, d_eta, d_E
+
+
+def test_matched_SE_is_eq_76_guarded_and_keeps_the_entropy_identity():
+    """S^E of eq. 76 (``se='matched'``): the scheme's extra energy rate is sum_b D_E^ab / V
+    with D_E^ab = S^E (1/Xi_a - 1/Xi_b) (eq. 66); where the bracket is positive and the cap
+    does not bind, the E-form pair dissipation equals the eta-form's (the matching); where it
+    is negative (colder than theta_R pairs can do this) S^E = 0; energy is conserved and
+    sum V nu . dU/dt = heat - D_total with every pair term >= 0."""
+    pa0, dx = cloud(seed=11)
+    s0, sc0 = rates(pa0, dx, form="E", jumps="raw")
+    pa, _ = cloud(seed=11)
+    s, sc = rates(pa, dx, form="E", jumps="raw", se="matched")
+    a, DE, SE, bracket, dxi, d_eta, d_E = _se_pairs(s, sc, pa)
+    assert (bracket < 0).sum() > 10 and (bracket > 0).sum() > 10     # both signs occur: the guard acts
+    extra = per_particle(a, DE, pa.n) / pa.V
+    np.testing.assert_allclose(pa.aE - pa0.aE, extra, rtol=0, atol=1e-12 * np.abs(pa0.aE).max())
+    assert np.abs(extra).max() > 1e-6 * np.abs(pa0.aE).max()          # S^E does something
+    capped = (SE > 0) & (SE * dxi ** 2 < bracket * (1 - 1e-12))
+    free = (SE > 0) & ~capped
+    assert free.sum() >= 5
+    np.testing.assert_allclose((d_E + SE * dxi ** 2)[free], d_eta[free], rtol=1e-10)
+    assert abs(np.sum(pa.V * pa.aE)) < 1e-12 * np.sum(pa.V * np.abs(pa.aE))
+    D0, pairs0 = pair_dissipation(s0, sc0, pa0)
+    D = D0 + 0.5 * np.sum(SE * dxi ** 2)
+    assert SE.min() >= 0 and D > D0
+    heat = heat_term(s, pa)
+    lhs = ballistic_rate(s, pa)
+    assert abs(lhs - (heat - D)) < 1e-10 * (abs(heat) + D), (lhs, heat, D)
+
+
+def test_matched_SE_vanishes_at_uniform_temperature_and_is_E_form_only():
+    """0/0 of eq. 76 at Xi_a = Xi_b: S^E = 0, the rates are those of S^E = 0 exactly."""
+    pa0, dx = cloud(seed=3)
+    pa0.theta[:] = 301.0
+    rates(pa0, dx, form="E")
+    pa, _ = cloud(seed=3)
+    pa.theta[:] = 301.0
+    rates(pa, dx, form="E", se="matched")
+    assert np.all(np.isfinite(pa.aE))
+    np.testing.assert_array_equal(pa.aE, pa0.aE)
+    with pytest.raises(InputError, match="E-form"):
+        ThermoUpwindScheme(["body"], MieGruneisen(**BASE), dx, form="eta", se="matched")
+    with pytest.raises(InputError, match="zero"):
+        ThermoUpwindScheme(["body"], MieGruneisen(**BASE), dx, se="yes")
