@@ -41,6 +41,7 @@ class SourceView:
     symbols: list
     calls: list
     loop_all: list
+    sums: list              # registers summed per pair: a partial each, added after the calls
 
 
 @dataclass(frozen=True)
@@ -66,12 +67,14 @@ def nbr_key(dest, src, reference):
     return f"{'rnb' if reference else 'nb'}_{dest}_{src}"
 
 
-def call(sp, dest, src=None, key=None, regs=()):
-    """The call of a generated method inside a loop over ``d_idx`` (and ``s_idx``)."""
+def call(sp, dest, src=None, key=None, regs=(), sums=()):
+    """The call of a generated method inside a loop over ``d_idx`` (and ``s_idx``);
+    registers by address: the per-pair partial for those in ``sums``."""
     args = []
     for a in sp.args:
         if is_property(a, "d_"):
-            args.append(f"&_r_{a[2:]}" if a[2:] in regs else f"{dest}_{a[2:]}")
+            x = a[2:]
+            args.append(f"&_p_{x}" if x in sums else f"&_r_{x}" if x in regs else f"{dest}_{x}")
         elif is_property(a, "s_"):
             args.append(f"{src}_{a[2:]}")
         elif a == "NBRS":
@@ -90,6 +93,7 @@ def declarations(plan, p):
     decls = ["cdef long s_idx = 0", "cdef long _k = 0"]
     decls += [f"cdef double {s} = 0.0" for s in scratch]
     decls += [f"cdef double _r_{x} = 0.0" for x in p.registers]
+    decls += [f"cdef double _p_{x} = 0.0" for x in p.sums]
     for row in sorted(rows, key=lambda r: not r.vector):   # arrays first, then scalars
         decls += row.declaration(plan.dim)
     return decls
@@ -99,9 +103,12 @@ def source_view(plan, p, loop):
     key = nbr_key(p.dest, loop.source, p.reference)
     pair = CythonPair(p.dest, loop.source, plan.dim, plan.domain, p.reference)
     symbols = [line for s in loop.symbols for line in pair_symbols.SYMBOLS[s].cython(pair)]
-    calls = {m: [call(p.spec(ep, m), p.dest, loop.source, key, p.registers) for ep in loop.calls(m)]
+    calls = {m: [call(p.spec(ep, m), p.dest, loop.source, key, p.registers, p.sums if m == "loop" else ())
+                 for ep in loop.calls(m)]
              for m in ("loop", "loop_all")}
-    return SourceView(loop.source, key, symbols, calls["loop"], calls["loop_all"])
+    used = {a[2:] for ep in loop.calls("loop") for a in p.spec(ep, "loop").args if is_property(a, "d_")}
+    sums = [x for x in p.sums if x in used]
+    return SourceView(loop.source, key, symbols, calls["loop"], calls["loop_all"], sums)
 
 
 def pass_view(plan, p):

@@ -76,11 +76,17 @@ cdef void _pass_${p.name}(long d_idx, double t, double dt) noexcept nogil:
     # source ${src.name}
     for _k in range(${src.key}_off[d_idx], ${src.key}_off[d_idx + 1]):
         s_idx = ${src.key}_idx[_k]
+% for x in src.sums:
+        _p_${x} = 0.0
+% endfor
 % for line in src.symbols:
         ${line}
 % endfor
 % for call in src.calls:
         ${call}
+% endfor
+% for x in src.sums:
+        _r_${x} += _p_${x}
 % endfor
 % for call in src.loop_all:
     ${call}

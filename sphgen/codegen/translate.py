@@ -241,6 +241,22 @@ def indexed_only_by_d_idx(spec):
     return ok
 
 
+def sums_only(spec, names):
+    """The names among ``names`` that ``spec`` only ever adds to: every access is the
+    target of ``d_X[...] += ...`` or ``-= ...`` (never read, never assigned)."""
+    ok = set(names)
+    targets = set()
+    for node in ast.walk(spec.fdef):
+        if isinstance(node, ast.AugAssign) and isinstance(node.op, (ast.Add, ast.Sub)) \
+                and isinstance(node.target, ast.Subscript):
+            targets.add(id(node.target))
+    for node in ast.walk(spec.fdef):
+        if isinstance(node, ast.Subscript) and isinstance(node.value, ast.Name) and \
+                node.value.id in ok and id(node) not in targets:
+            ok.discard(node.value.id)
+    return ok
+
+
 class _RegisterForm(ast.NodeTransformer):
     """Index the named arguments with 0 instead of ``d_idx``."""
 

@@ -3,10 +3,16 @@
 A double property of the destination that the pair loops of a pass write, and only
 ever as ``d_X[d_idx]``, is loaded into a local before the neighbour loops and stored
 after them; the loop methods get its address and index it with 0.
+
+A register the pair methods only ever add to (``+=`` / ``-=``, never read or assigned)
+is a *sum*: each pair's contributions go into a per-pair partial that starts at 0 and
+is added to the register once per pair.  The loop then carries one reduction per sum
+instead of a chain through every equation, which lets the C compiler vectorise the
+neighbour loop (several pairs per instruction).
 """
 from ...equation import PAIR_METHODS
 from ..plan import is_property
-from ..translate import in_registers, indexed_only_by_d_idx
+from ..translate import in_registers, indexed_only_by_d_idx, sums_only
 
 
 def register_candidates(plan, p):
@@ -20,16 +26,33 @@ def register_candidates(plan, p):
     return {a[2:] for a in writes - bad if plan.dtype(p.dest, a[2:]) == "double"}
 
 
+def sum_registers(p, regs):
+    """The registers every per-pair (``loop``) method of the pass only adds to."""
+    names = {f"d_{x}" for x in regs}
+    for loop in p.sources:
+        for ep in loop.equations:
+            for m in PAIR_METHODS:
+                if m in ep.methods:
+                    sp = ep.methods[m]
+                    used = names & set(sp.args)
+                    names -= used - sums_only(sp, used) if m == "loop" else used
+    return {a[2:] for a in names}
+
+
 def assign_registers(plan):
-    """Decide each pass's registers and the register form of its pair methods."""
+    """Decide each pass's registers, its sums and the register form of its pair methods."""
     notes = []
     for p in plan.neighbour_passes():
         regs = register_candidates(plan, p)
         p.registers = tuple(sorted(regs))
+        p.sums = tuple(sorted(sum_registers(p, regs)))
         if not regs:
             continue
         names = {f"d_{x}" for x in regs}
         p.pair_specs = {(ep.index, m): in_registers(sp, names & set(sp.args))
                         for ep in p.equations for m, sp in ep.methods.items() if m in PAIR_METHODS}
-        notes.append(f"{p.label}: {', '.join(p.registers)} accumulated in registers")
+        note = f"{p.label}: {', '.join(p.registers)} accumulated in registers"
+        if p.sums:
+            note += f" (summed per pair: {', '.join(p.sums)})"
+        notes.append(note)
     return notes
