@@ -69,15 +69,15 @@ cdef void _pass_${p.name}(long d_idx, double t, double dt) noexcept nogil:
 % for call in p.initialize:
     ${call}
 % endfor
-% for x, arr in p.registers:
-    _r_${x} = ${arr}[d_idx]
+% for line in p.load_registers:
+    ${line}
 % endfor
 % for src in p.sources:
     # source ${src.name}
     for _k in range(${src.key}_off[d_idx], ${src.key}_off[d_idx + 1]):
         s_idx = ${src.key}_idx[_k]
-% for x in src.sums:
-        _p_${x} = 0.0
+% for line in src.zero_partials:
+        ${line}
 % endfor
 % for line in src.symbols:
         ${line}
@@ -85,15 +85,15 @@ cdef void _pass_${p.name}(long d_idx, double t, double dt) noexcept nogil:
 % for call in src.calls:
         ${call}
 % endfor
-% for x in src.sums:
-        _r_${x} += _p_${x}
+% for line in src.add_partials:
+        ${line}
 % endfor
 % for call in src.loop_all:
     ${call}
 % endfor
 % endfor
-% for x, arr in p.registers:
-    ${arr}[d_idx] = _r_${x}
+% for line in p.store_registers:
+    ${line}
 % endfor
 % for call in p.post_loop:
     ${call}
