@@ -81,7 +81,8 @@ def quintic_dwdr(r=0.0, h=1.0, fac=1.0, dim=2):
     """dW/dr of the quintic spline at any smoothing length h (``fac`` is its normalisation
     sigma_d).  The scene's kernel is callable only at h_ab (the DWIJ symbol); this helper
     gives the reduced-h gradient of the GTVF and is tested against sphgen.kernels."""
-    q = r / h
+    hi = 1.0 / h
+    q = r * hi
     a = 3.0 - q
     b = 2.0 - q
     c = 1.0 - q
@@ -92,12 +93,12 @@ def quintic_dwdr(r=0.0, h=1.0, fac=1.0, dim=2):
         val = a * a * a * a - 6.0 * b * b * b * b
     elif q < 3.0:
         val = a * a * a * a
-    s = fac / h
+    s = fac * hi
     if dim > 1:
-        s = s / h
+        s = s * hi
     if dim > 2:
-        s = s / h
-    return -5.0 * s * val / h
+        s = s * hi
+    return -5.0 * s * val * hi
 
 
 class GTVFHomogenisation(Equation):

@@ -111,16 +111,18 @@ class DensityDiffusion(Equation):
     def loop(self, d_idx, d_arho, d_rho, d_gradrho, s_idx, s_m, s_rho, s_gradrho,
              XIJ, DWIJ, R2IJ, HIJ):
         if self.delta != 0.0:
-            if R2IJ > 1e-12 * HIJ * HIJ:
-                vb = s_m[s_idx] / s_rho[s_idx]
-                xdotdw = XIJ[0] * DWIJ[0] + XIJ[1] * DWIJ[1] + XIJ[2] * DWIJ[2]
-                # (x_b - x_a) . grad W = -XIJ . DWIJ; 1/r^2 unregularised as in the papers (the
-                # pair term is bounded: xdotdw ~ r W'), so a linear rho gives exactly zero
-                psidw = -2.0 * (s_rho[s_idx] - d_rho[d_idx]) * xdotdw / R2IJ
-                if self.correction:
-                    for i in range(3):
-                        psidw -= (d_gradrho[3 * d_idx + i] + s_gradrho[3 * s_idx + i]) * DWIJ[i]
-                d_arho[d_idx] += self.delta * HIJ * self.c0 * psidw * vb
+            vb = s_m[s_idx] / s_rho[s_idx]
+            xdotdw = XIJ[0] * DWIJ[0] + XIJ[1] * DWIJ[1] + XIJ[2] * DWIJ[2]
+            # (x_b - x_a) . grad W = -XIJ . DWIJ; 1/r^2 unregularised as in the papers (the
+            # pair term is bounded: xdotdw ~ r W'), so a linear rho gives exactly zero.  r^2 is
+            # floored at 1e-12 h^2 instead of skipping the pair: at r = 0 (a particle and
+            # itself) XIJ = DWIJ = 0 and the term is 0 either way, and the loop has no branch.
+            r2 = R2IJ if R2IJ > 1e-12 * HIJ * HIJ else 1e-12 * HIJ * HIJ
+            psidw = -2.0 * (s_rho[s_idx] - d_rho[d_idx]) * xdotdw / r2
+            if self.correction:
+                for i in range(3):
+                    psidw -= (d_gradrho[3 * d_idx + i] + s_gradrho[3 * s_idx + i]) * DWIJ[i]
+            d_arho[d_idx] += self.delta * HIJ * self.c0 * psidw * vb
 
 
 @helper

@@ -34,12 +34,10 @@ class Kernel:
         return s
 
     def dwdr_over_r(self, rij=1.0, h=1.0):
-        """(1/r) dW/dr, so that grad W = dwdr_over_r x_ij; 0 at r = 0 (a kernel with a closed
-        form that needs no division by r overrides this)."""
-        val = 0.0
-        if rij > 1e-12:
-            val = self.dwdr(rij, h) / rij
-        return val
+        """(1/r) dW/dr, so that grad W = dwdr_over_r x_ij; 0 at r = 0, where dW/dr = 0 (a
+        kernel with a closed form that needs no division by r overrides this).  No branch:
+        r is floored at 1e-12, so the pair loop can be vectorised."""
+        return self.dwdr(rij, h) / (rij if rij > 1e-12 else 1e-12)
 
     def constants(self):
         """Attributes folded into the generated code."""
@@ -66,7 +64,7 @@ class QuinticSpline(Kernel):
 
         No branch on the piece of q: (x)+ = (x + |x|)/2 exactly, and a piece that is off adds an
         exact 0 (a neighbour's piece is random, so branches on it are mispredicted)."""
-        q = rij / h
+        q = rij * (1.0 / h)
         t3 = 0.5 * (3.0 - q + fabs(3.0 - q))
         t2 = 0.5 * (2.0 - q + fabs(2.0 - q))
         t1 = 0.5 * (1.0 - q + fabs(1.0 - q))
@@ -78,7 +76,8 @@ class QuinticSpline(Kernel):
 
     def dwdr(self, rij=1.0, h=1.0):
         """dW/dr = -5 sigma/h^(d+1) [(3-q)+^4 - 6(2-q)+^4 + 15(1-q)+^4], branch-free as w."""
-        q = rij / h
+        hi = 1.0 / h
+        q = rij * hi
         a = 0.5 * (3.0 - q + fabs(3.0 - q))
         b = 0.5 * (2.0 - q + fabs(2.0 - q))
         c = 0.5 * (1.0 - q + fabs(1.0 - q))
@@ -86,7 +85,7 @@ class QuinticSpline(Kernel):
         b2 = b * b
         c2 = c * c
         val = a2 * a2 - 6.0 * b2 * b2 + 15.0 * c2 * c2
-        return -5.0 * self.sigma(h) * val / h
+        return -5.0 * self.sigma(h) * val * hi
 
     def gradh(self, rij=1.0, h=1.0):
         """h dW/dh = -(d W + r dW/dr)."""
@@ -132,7 +131,7 @@ class WendlandQuinticC2(Kernel):
 
     def w(self, rij=1.0, h=1.0):
         """W(r, h) = a_d/h^d (1 - q/2)^4 (1 + 2q) for q = r/h < 2."""
-        q = rij / h
+        q = rij * (1.0 / h)
         val = 0.0
         if q < 2.0:
             t = 1.0 - 0.5 * q
@@ -141,12 +140,13 @@ class WendlandQuinticC2(Kernel):
 
     def dwdr(self, rij=1.0, h=1.0):
         """dW/dr = -5 a_d/h^(d+1) q (1 - q/2)^3 for q < 2."""
-        q = rij / h
+        hi = 1.0 / h
+        q = rij * hi
         val = 0.0
         if q < 2.0:
             t = 1.0 - 0.5 * q
             val = -5.0 * q * t * t * t
-        return self.sigma(h) * val / h
+        return self.sigma(h) * val * hi
 
     def dwdr_over_r(self, rij=1.0, h=1.0):
         """(1/r) dW/dr = -5 a_d/h^(d+2) (1 - q/2)^3 for q < 2: smooth, no division by r (the q
@@ -170,12 +170,13 @@ class WendlandQuinticC2(Kernel):
         is -35/(8 pi h^4) (1 - q/2)^2 (7q - 8): Kincl et al. (2023), sec. 3.5, print 35/(4 pi h^4),
         twice too large; their 3D formula -105/(16 pi h^5) (1 - q/2)^2 (4q - 5) agrees with this.
         """
-        q = rij / h
+        hi = 1.0 / h
+        q = rij * hi
         val = 0.0
         if q < 2.0:
             t = 1.0 - 0.5 * q
             val = 5.0 * t * t * ((self.dim + 2.0) - 0.5 * (self.dim + 5.0) * q)
-        return self.sigma(h) * val / (h * h)
+        return self.sigma(h) * val * hi * hi
 
 
 KERNELS = {"quintic": QuinticSpline, "wendland": WendlandQuinticC2}

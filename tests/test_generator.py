@@ -131,7 +131,7 @@ def test_pair_loop_accumulators_live_in_registers():
     sc = _scene(["u", "omega"], alpha=0.5)
     src = sc.source
     assert "_r_au = fluid_au[d_idx]" in src and "fluid_au[d_idx] = _r_au" in src
-    assert "&_r_au" in src and "d_au[0] +=" in src
+    assert "&_p_au" in src and "d_au[0] +=" in src and "_r_au += _p_au" in src   # summed per pair
 
 
 def test_show_plan_reports_every_pass_in_order():

@@ -36,9 +36,8 @@ def test_properties_follow_dimension_and_reference_configuration():
 
 def test_cython_rows_fold_dimension_and_period():
     pair = CythonPair("fluid", "wall", 2, periodic_box(2, L=2.0))
-    assert pair_symbols.SYMBOLS["XIJ"].cython(pair)[:5] == [
-        "XIJ[0] = fluid_x[d_idx] - wall_x[s_idx]",
-        "if XIJ[0] > 1.0:", "    XIJ[0] -= 2.0", "elif XIJ[0] < -1.0:", "    XIJ[0] += 2.0"]
+    assert pair_symbols.SYMBOLS["XIJ"].cython(pair)[:2] == [     # minimum image without a branch
+        "XIJ[0] = fluid_x[d_idx] - wall_x[s_idx]", "XIJ[0] -= 2.0 * rint(XIJ[0] * 0.5)"]
     assert pair_symbols.SYMBOLS["R2IJ"].cython(pair) == ["R2IJ = XIJ[0] * XIJ[0] + XIJ[1] * XIJ[1]"]
     assert pair_symbols.SYMBOLS["DWIJ"].declaration(2) == ["cdef double DWIJ[3]", "DWIJ[2] = 0.0"]
     ref = CythonPair("fluid", "fluid", 2, periodic_box(2), reference=True)

@@ -56,6 +56,15 @@ class Flags(Equation):
         d_e[d_idx] += s_flag[s_idx] * WIJ * mystery
 
 
+class Largest(Equation):
+    """e: the largest W over neighbours (a register that is read: not a sum)."""
+
+    def loop(self, d_idx, d_e, d_au, s_idx, WIJ):
+        d_au[d_idx] += WIJ
+        if WIJ > d_e[d_idx]:
+            d_e[d_idx] = WIJ
+
+
 class Kick(IntegratorStep):
     def stage1(self, d_idx, d_u, d_au, dt):
         d_u[d_idx] += dt * d_au[d_idx]
@@ -84,11 +93,40 @@ def test_assign_registers_only_for_doubles_indexed_by_d_idx():
     (p,) = plan.neighbour_passes()
     ep = p.equations[0]
     assert p.registers == () and p.spec(ep, "loop") is ep.methods["loop"]
-    assert passes.assign_registers(plan) == ["g0_fluid: au accumulated in registers"]
-    assert p.registers == ("au",)
+    assert passes.assign_registers(plan) == ["g0_fluid: au, grad accumulated in registers (summed per pair: au, grad)"]
+    assert p.registers == ("au", "grad") and p.sums == ("au", "grad")
     assert "d_au[0] += Viscous_0_nu" in ast.unparse(p.spec(ep, "loop").fdef)
     assert "d_au[d_idx] +=" in ast.unparse(ep.methods["loop"].fdef)     # the plain form is kept
-    assert "d_grad[3 * d_idx + i] +=" in ast.unparse(p.spec(ep, "loop").fdef)
+    assert "d_grad[i] +=" in ast.unparse(p.spec(ep, "loop").fdef)      # a strided register: its row
+
+
+def test_assign_registers_sums_only_what_the_pair_loops_only_add_to():
+    plan = _plan([Largest("fluid", ["fluid"]), Viscous("fluid", ["fluid"], nu=0.1)], "assign_registers")
+    (p,) = plan.neighbour_passes()
+    assert passes.assign_registers(plan) == ["g0_fluid: au, e, grad accumulated in registers (summed per pair: au, grad)"]
+    assert p.registers == ("au", "e", "grad") and p.sums == ("au", "grad")
+
+
+def test_rendered_pass_adds_each_pairs_partial_sum_once():
+    from sphgen.codegen.render import render
+    plan = passes.run(_plan([Largest("fluid", ["fluid"]), Viscous("fluid", ["fluid"], nu=0.1)], "allocate"),
+                      passes.PASSES[passes.PASSES.index(passes.choose_pair_symbols):])
+    src = render(plan).source
+    loop = src[src.index("cdef void _pass_g0_fluid"):src.index("def pass_g0_fluid")]
+    assert "_p_au = 0.0\n" in loop and loop.count("_r_au += _p_au") == 1
+    assert "Largest_0_loop(d_idx, &_r_e, &_p_au," in loop and "&_p_e" not in loop
+    assert "Viscous_1_loop(d_idx, &_p_au, _p_grad," in loop      # a strided register: a local row
+    assert "_p_grad[2] = 0.0" in loop and "_r_grad[2] += _p_grad[2]" in loop
+    assert "fluid_grad[3 * d_idx + 2] = _r_grad[2]" in loop
+
+
+@pytest.mark.parametrize("index, stride, offset", [
+    ("d_idx", 1, "0"), ("9 * d_idx + 3 * i + j", 9, "3 * i + j"), ("j + d_idx * 3", 3, "j"),
+    ("3 * d_idx", 3, "0"), ("3 * d_idx + i", 9, None), ("3 * d_idx + d_idx", 3, None), ("d_idx + 1", 1, None)])
+def test_row_offset_of_a_strided_index(index, stride, offset):
+    from sphgen.codegen.translate import _row_offset
+    got = _row_offset(ast.parse(index, mode="eval").body, stride)
+    assert (None if got is None else ast.unparse(got)) == offset
 
 
 def test_collect_functions_orders_passes_then_stages_and_lists_parameters():

@@ -125,6 +125,7 @@ class NeighbourPass:
     equations: list                  # the group's kept EqPlans with this destination
     sources: list = field(default_factory=list)      # SourceLoops, in order of first use
     registers: tuple = ()            # destination doubles accumulated in locals
+    sums: tuple = ()                 # registers only added to: summed per pair first
     pair_specs: dict = field(default_factory=dict)   # (eq index, method) -> register form
 
     def calls(self, method):

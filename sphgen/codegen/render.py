@@ -41,6 +41,8 @@ class SourceView:
     symbols: list
     calls: list
     loop_all: list
+    zero_partials: list     # per pair, before the calls: the partials of the sums set to 0
+    add_partials: list      # per pair, after the calls: each partial added to its register
 
 
 @dataclass(frozen=True)
@@ -49,8 +51,9 @@ class PassView:
     dest: str
     decls: list
     initialize: list
-    registers: list
+    load_registers: list
     sources: list
+    store_registers: list
     post_loop: list
 
 
@@ -66,12 +69,20 @@ def nbr_key(dest, src, reference):
     return f"{'rnb' if reference else 'nb'}_{dest}_{src}"
 
 
-def call(sp, dest, src=None, key=None, regs=()):
-    """The call of a generated method inside a loop over ``d_idx`` (and ``s_idx``)."""
+def call(sp, dest, src=None, key=None, regs=None, sums=()):
+    """The call of a generated method inside a loop over ``d_idx`` (and ``s_idx``).
+
+    ``regs`` (register -> stride): these go by address, the per-pair partial for those
+    in ``sums``; a strided register is a local array."""
+    regs = regs or {}
     args = []
     for a in sp.args:
         if is_property(a, "d_"):
-            args.append(f"&_r_{a[2:]}" if a[2:] in regs else f"{dest}_{a[2:]}")
+            x = a[2:]
+            if x in regs:
+                args.append(("" if regs[x] > 1 else "&") + ("_p_" if x in sums else "_r_") + x)
+            else:
+                args.append(f"{dest}_{x}")
         elif is_property(a, "s_"):
             args.append(f"{src}_{a[2:]}")
         elif a == "NBRS":
@@ -89,27 +100,49 @@ def declarations(plan, p):
     scratch = dict.fromkeys(s for row in rows for s in row.scratch)
     decls = ["cdef long s_idx = 0", "cdef long _k = 0"]
     decls += [f"cdef double {s} = 0.0" for s in scratch]
-    decls += [f"cdef double _r_{x} = 0.0" for x in p.registers]
+    strides = register_strides(plan, p)
+    for pre, names in (("_r_", p.registers), ("_p_", p.sums)):
+        decls += [f"cdef double {pre}{x}[{strides[x]}]" if strides[x] > 1 else f"cdef double {pre}{x} = 0.0"
+                  for x in names]
     for row in sorted(rows, key=lambda r: not r.vector):   # arrays first, then scalars
         decls += row.declaration(plan.dim)
     return decls
+
+
+def register_strides(plan, p):
+    """{register: stride of its property}."""
+    return {x: plan.arrays[p.dest].props[x].stride for x in p.registers}
+
+
+def _rows(x, k):
+    """The local names of register x's row (stride k)."""
+    return [x] if k == 1 else [f"{x}[{i}]" for i in range(k)]
 
 
 def source_view(plan, p, loop):
     key = nbr_key(p.dest, loop.source, p.reference)
     pair = CythonPair(p.dest, loop.source, plan.dim, plan.domain, p.reference)
     symbols = [line for s in loop.symbols for line in pair_symbols.SYMBOLS[s].cython(pair)]
-    calls = {m: [call(p.spec(ep, m), p.dest, loop.source, key, p.registers) for ep in loop.calls(m)]
+    strides = register_strides(plan, p)
+    calls = {m: [call(p.spec(ep, m), p.dest, loop.source, key, strides, p.sums if m == "loop" else ())
+                 for ep in loop.calls(m)]
              for m in ("loop", "loop_all")}
-    return SourceView(loop.source, key, symbols, calls["loop"], calls["loop_all"])
+    used = {a[2:] for ep in loop.calls("loop") for a in p.spec(ep, "loop").args if is_property(a, "d_")}
+    rows = [r for x in p.sums if x in used for r in _rows(x, strides[x])]
+    return SourceView(loop.source, key, symbols, calls["loop"], calls["loop_all"],
+                      [f"_p_{r} = 0.0" for r in rows], [f"_r_{r} += _p_{r}" for r in rows])
 
 
 def pass_view(plan, p):
+    strides = register_strides(plan, p)
+    pairs = [(f"_r_{x}" + (f"[{i}]" if k > 1 else ""), f"{p.dest}_{x}[{k} * d_idx + {i}]" if k > 1
+              else f"{p.dest}_{x}[d_idx]") for x, k in strides.items() for i in range(k)]
     return PassView(
         p.label, p.dest, declarations(plan, p),
         [call(ep.methods["initialize"], p.dest) for ep in p.calls("initialize")],
-        [(x, f"{p.dest}_{x}") for x in p.registers],
+        [f"{r} = {m}" for r, m in pairs],
         [source_view(plan, p, loop) for loop in p.sources],
+        [f"{m} = {r}" for r, m in pairs],
         [call(ep.methods["post_loop"], p.dest) for ep in p.calls("post_loop")])
 
 

@@ -69,25 +69,31 @@ cdef void _pass_${p.name}(long d_idx, double t, double dt) noexcept nogil:
 % for call in p.initialize:
     ${call}
 % endfor
-% for x, arr in p.registers:
-    _r_${x} = ${arr}[d_idx]
+% for line in p.load_registers:
+    ${line}
 % endfor
 % for src in p.sources:
     # source ${src.name}
     for _k in range(${src.key}_off[d_idx], ${src.key}_off[d_idx + 1]):
         s_idx = ${src.key}_idx[_k]
+% for line in src.zero_partials:
+        ${line}
+% endfor
 % for line in src.symbols:
         ${line}
 % endfor
 % for call in src.calls:
         ${call}
 % endfor
+% for line in src.add_partials:
+        ${line}
+% endfor
 % for call in src.loop_all:
     ${call}
 % endfor
 % endfor
-% for x, arr in p.registers:
-    ${arr}[d_idx] = _r_${x}
+% for line in p.store_registers:
+    ${line}
 % endfor
 % for call in p.post_loop:
     ${call}
@@ -116,18 +122,19 @@ def stage_${s.name}(double t, double dt):
 # ---------------------------------------------------------------- blow-up guard
 def count_nonfinite():
     """[(array, property, count of non-finite values)]: one parallel sweep per array and
-    stride adds x * 0.0 of every value (NaN as soon as one is not finite); only then
-    is each property counted on its own."""
+    stride counts the values that are not finite (an integer count: the module is built
+    with re-associated floating-point sums, so no trick on x * 0.0); only if some are is
+    each property counted on its own."""
     cdef long i
-    cdef double acc = 0.0
+    cdef long bad = 0
 % for arr, props in guarded:
 % for stride in sorted(set(st for _, st in props)):
     with nogil:
         for i in prange(${arr}_n * ${stride}, num_threads=_nthreads, schedule='static'):
-            acc += ${" + ".join(f"{arr}_{p}[i] * 0.0" for p, st in props if st == stride)}
+            bad += ${" + ".join(f"(not isfinite({arr}_{p}[i]))" for p, st in props if st == stride)}
 % endfor
 % endfor
-    if isfinite(acc):
+    if bad == 0:
         return []
     return _count_nonfinite_each()
 

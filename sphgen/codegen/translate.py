@@ -226,12 +226,47 @@ class Specialised:
         return [a for a in self.args if a in pair_symbols.SYMBOLS]
 
 
-def indexed_only_by_d_idx(spec):
-    """d_* arguments every access of which is ``d_X[d_idx]``."""
+def _is_d_idx(node):
+    return isinstance(node, ast.Name) and node.id == "d_idx"
+
+
+def _terms(node):
+    """The terms of a sum ``a + b + ...`` (nested additions flattened)."""
+    if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Add):
+        return _terms(node.left) + _terms(node.right)
+    return [node]
+
+
+def _row_offset(index, stride):
+    """``e`` if ``index`` is ``stride * d_idx + e`` (the terms of the sum in any order;
+    ``stride * d_idx`` alone gives 0, and a stride of 1 accepts ``d_idx`` only); None
+    otherwise."""
+    if stride == 1:
+        return ast.Constant(0) if _is_d_idx(index) else None
+
+    def scaled(n):
+        return isinstance(n, ast.BinOp) and isinstance(n.op, ast.Mult) and any(
+            _is_d_idx(a) and isinstance(b, ast.Constant) and b.value == stride
+            for a, b in ((n.left, n.right), (n.right, n.left)))
+    terms = _terms(index)
+    rows = [t for t in terms if scaled(t)]
+    rest = [t for t in terms if not scaled(t)]
+    if len(rows) != 1 or any(_is_d_idx(n) for t in rest for n in ast.walk(t)):
+        return None
+    offset = rest[0] if rest else ast.Constant(0)
+    for t in rest[1:]:
+        offset = ast.BinOp(offset, ast.Add(), t)
+    return offset
+
+
+def indexed_by_row(spec, strides):
+    """d_* arguments every access of which is ``d_X[k * d_idx + e]`` with k the stride of X
+    (``strides``: argument -> stride; ``d_X[d_idx]`` when it is 1): the row of the
+    destination particle, nothing else."""
     ok = {a for a in spec.args if a.startswith("d_") and a != "d_idx"}
     for node in ast.walk(spec.fdef):
         if isinstance(node, ast.Subscript) and isinstance(node.value, ast.Name) and node.value.id in ok:
-            if not (isinstance(node.slice, ast.Name) and node.slice.id == "d_idx"):
+            if _row_offset(node.slice, strides.get(node.value.id, 1)) is None:
                 ok.discard(node.value.id)
     # a bare use (passing the pointer on) also disqualifies
     subs = {id(n.value) for n in ast.walk(spec.fdef) if isinstance(n, ast.Subscript)}
@@ -241,28 +276,45 @@ def indexed_only_by_d_idx(spec):
     return ok
 
 
-class _RegisterForm(ast.NodeTransformer):
-    """Index the named arguments with 0 instead of ``d_idx``."""
+def sums_only(spec, names):
+    """The names among ``names`` that ``spec`` only ever adds to: every access is the
+    target of ``d_X[...] += ...`` or ``-= ...`` (never read, never assigned)."""
+    ok = set(names)
+    targets = set()
+    for node in ast.walk(spec.fdef):
+        if isinstance(node, ast.AugAssign) and isinstance(node.op, (ast.Add, ast.Sub)) \
+                and isinstance(node.target, ast.Subscript):
+            targets.add(id(node.target))
+    for node in ast.walk(spec.fdef):
+        if isinstance(node, ast.Subscript) and isinstance(node.value, ast.Name) and \
+                node.value.id in ok and id(node) not in targets:
+            ok.discard(node.value.id)
+    return ok
 
-    def __init__(self, names):
-        self.names = names
+
+class _RegisterForm(ast.NodeTransformer):
+    """Index the named arguments by their offset in the destination's row instead."""
+
+    def __init__(self, strides):
+        self.strides = strides
 
     def visit_Subscript(self, node):
         self.generic_visit(node)
-        if isinstance(node.value, ast.Name) and node.value.id in self.names:
-            node.slice = ast.copy_location(ast.Constant(0), node.slice)
+        if isinstance(node.value, ast.Name) and node.value.id in self.strides:
+            node.slice = ast.copy_location(_row_offset(node.slice, self.strides[node.value.id]), node.slice)
         return node
 
 
-def in_registers(spec, names):
-    """A copy of ``spec`` where ``d_X[d_idx]`` reads/writes ``d_X[0]`` for X in names.
+def in_registers(spec, strides):
+    """A copy of ``spec`` where ``d_X[k * d_idx + e]`` reads/writes ``d_X[e]`` for X in
+    ``strides`` (argument -> stride k; ``d_X[d_idx]`` becomes ``d_X[0]``).
 
     The neighbour pass then hands these equations the address of a local accumulator,
     so ``d_au[d_idx] += ...`` over all neighbours stays in a register instead of a
     load-add-store through memory per pair.
     """
     new = copy.copy(spec)
-    new.fdef = ast.fix_missing_locations(_RegisterForm(names).visit(copy.deepcopy(spec.fdef)))
+    new.fdef = ast.fix_missing_locations(_RegisterForm(strides).visit(copy.deepcopy(spec.fdef)))
     return new
 
 
