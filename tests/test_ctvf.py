@@ -457,3 +457,16 @@ def test_ctvf_corrections_lower_the_l1_error(tmp_path):
     with_ = tg_whole_run(tmp_path, "ctvf", 1000, "--perturb", "0", nx=100)["l1_error"]
     without = tg_whole_run(tmp_path, "ctvf", 1000, "--no-corrections", "--perturb", "0", nx=100)["l1_error"]
     assert with_ < without
+
+
+def test_fluid_scheme_edac_damping_and_form_options():
+    """edac_damping='paper' is eq. 26's printed damping, nu_edac / rho0 (digest A3); the
+    momentum term forms are checked by name."""
+    kw = dict(dim=2, rho0=1000.0, c0=10.0, nu=0.0, h=0.1, dx=0.1)
+    consistent = CTVFScheme(["fluid"], **kw)
+    paper = CTVFScheme(["fluid"], edac_damping="paper", **kw)
+    assert consistent.nu_edac() == pytest.approx(0.5 * 0.1 * 10.0 / 8.0)
+    assert paper.nu_edac() == pytest.approx(consistent.nu_edac() / 1000.0)
+    for bad in (dict(edac_damping="printed"), dict(divergence_form="u"), dict(stress_form="x")):
+        with pytest.raises(ValueError):
+            CTVFScheme(["fluid"], **kw, **bad)
