@@ -121,6 +121,12 @@ class DamBreak2D(Application):
                                 "eq. 55), 0.05 for ctvf)")
         group.add_argument("--no-surface-pressure", dest="surface_pressure", action="store_false",
                            help="ctvf: do not hold p = 0 on the free-surface particles")
+        group.add_argument("--nu", type=float, default=0.0,
+                           help="ctvf: kinematic viscosity, m^2/s, with the no-slip wall ghost velocity "
+                                "(default %(default)s; water 1e-6)")
+        group.add_argument("--edac-damping", choices=("consistent", "paper"), default="consistent",
+                           help="ctvf: the pressure damping of eq. 26 as a Laplacian (default) or as printed "
+                                "(an extra 1/rho: 1000 times weaker for water)")
         group.add_argument("--delta", type=float, default=0.1,
                            help="delta-SPH coefficient, 0 turns it off (default %(default)s)")
         group.add_argument("--no-delta-correction", dest="delta_correction", action="store_false",
@@ -188,9 +194,10 @@ class DamBreak2D(Application):
     def create_scheme(self):
         o = self.options
         if o.scheme == "ctvf":
-            return CTVFScheme(["fluid"], dim=2, rho0=RHO0, c0=self.c0, nu=0.0, h=self.h, dx=self.dx,
+            return CTVFScheme(["fluid"], dim=2, rho0=RHO0, c0=self.c0, nu=o.nu, h=self.h, dx=self.dx,
                               umax=sqrt(2.0 * G * H), density="continuity", alpha=o.alpha, gy=-G,
-                              walls=["wall"], free_surface=True, surface_pressure=o.surface_pressure)
+                              walls=["wall"], free_surface=True, surface_pressure=o.surface_pressure,
+                              edac_damping=o.edac_damping)
         if o.scheme == "variational":
             return VariationalScheme(["fluid"], ["wall"], dim=2, rho0=RHO0, c0=self.c0, gy=-G, kernel="K3",
                                      dx=self.dx, av_a=o.alpha, av_b=0.0, D=2.0 * G * H, r0=self.dx,

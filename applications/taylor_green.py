@@ -85,6 +85,10 @@ class TaylorGreen(Application):
                            ("stress", "the momentum term div(u (x) (u~ - u))"),
                            ("divergence", "the momentum term -u div(u~ - u)")):
             group.add_argument(f"--no-{term}-correction", action="store_true", help=f"ctvf: without {what}")
+        group.add_argument("--divergence-form", choices=("delta", "printed"), default="delta",
+                           help="ctvf: the -u div term with delta_ab (eq. 19, default) or u~_ab (eq. 27 as printed)")
+        group.add_argument("--stress-form", choices=("symmetric", "difference"), default="symmetric",
+                           help="ctvf: the A term of eq. 27 as printed (symmetric, default) or as a difference")
         group.add_argument("--density", choices=("summation", "continuity"), default=None,
                            help="ctvf/gtvf: summation density, or continuity with u~ (default: "
                            "summation for ctvf, continuity for gtvf)")
@@ -164,7 +168,8 @@ class TaylorGreen(Application):
             corrections = tuple(c for c in ("edac", "stress", "divergence", "continuity") if c not in off)
             s = CTVFScheme(["fluid"], shifting=o.shifting or "spst", corrections=corrections,
                            density=o.density or "summation", bql=True if o.bql is None else o.bql,
-                           **common, **ipst)
+                           divergence_form=o.divergence_form,
+                           stress_form=o.stress_form, **common, **ipst)
         else:
             s = GTVFScheme(["fluid"], shifting=o.shifting or "gtvf", density=o.density or "continuity",
                            **common, **ipst)

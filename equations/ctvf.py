@@ -44,21 +44,24 @@ class EDACTransportCorrection(Equation):
 class MomentumTransportDivergence(Equation):
     """du_a/dt += u_a sum_b V_b (delta_a - delta_b) . grad W_ab, a discrete -u div(u~ - u)
     (Adepu & Ramachandran 2021, eq. 19, second term).  Eq. 27 prints u~_ab where eq. 19
-    needs delta_ab = u~_ab - u_ab; this uses delta_ab.  Not antisymmetric: it does not
-    conserve linear momentum pair by pair."""
+    needs delta_ab = u~_ab - u_ab; this uses delta_ab unless ``printed`` (then u~_ab, a
+    discrete -u div(u~)).  Not antisymmetric: it does not conserve linear momentum pair
+    by pair."""
 
-    switches = ("enabled",)
+    switches = ("enabled", "printed")
 
-    def __init__(self, dest, sources, enabled=True):
-        super().__init__(dest, sources, enabled=bool(enabled))
+    def __init__(self, dest, sources, enabled=True, printed=False):
+        super().__init__(dest, sources, enabled=bool(enabled), printed=int(bool(printed)))
 
     def loop(self, d_idx, d_au, d_av, d_aw, d_u, d_v, d_w, d_uhat, d_vhat, d_what,
              s_idx, s_m, s_rho, s_u, s_v, s_w, s_uhat, s_vhat, s_what, DWIJ):
         if self.enabled:
-            dx = (d_uhat[d_idx] - d_u[d_idx]) - (s_uhat[s_idx] - s_u[s_idx])
-            dy = (d_vhat[d_idx] - d_v[d_idx]) - (s_vhat[s_idx] - s_v[s_idx])
-            dz = (d_what[d_idx] - d_w[d_idx]) - (s_what[s_idx] - s_w[s_idx])
-            f = s_m[s_idx] / s_rho[s_idx] * (dx * DWIJ[0] + dy * DWIJ[1] + dz * DWIJ[2])
+            f = ((d_uhat[d_idx] - s_uhat[s_idx]) * DWIJ[0] + (d_vhat[d_idx] - s_vhat[s_idx]) * DWIJ[1]
+                 + (d_what[d_idx] - s_what[s_idx]) * DWIJ[2])
+            if not self.printed:
+                f = f - ((d_u[d_idx] - s_u[s_idx]) * DWIJ[0] + (d_v[d_idx] - s_v[s_idx]) * DWIJ[1]
+                         + (d_w[d_idx] - s_w[s_idx]) * DWIJ[2])
+            f = f * s_m[s_idx] / s_rho[s_idx]
             d_au[d_idx] += f * d_u[d_idx]
             d_av[d_idx] += f * d_v[d_idx]
             d_aw[d_idx] += f * d_w[d_idx]

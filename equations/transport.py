@@ -13,12 +13,15 @@ class TransportStress(Equation):
     """du_a/dt += sum_b m_b (u_a (x) delta_a / rho_a + u_b (x) delta_b / rho_b) . grad W_ab,
     delta = u~ - u: the divergence of u (x) (u~ - u), the TVF 'A' term (Adami, Hu & Adams
     2013, eq. 9; Adepu & Ramachandran 2021, eq. 27).  ``enabled`` is a switch: False
-    removes it from the generated code (the CTVF runs without corrections)."""
+    removes it from the generated code (the CTVF runs without corrections).
+    ``difference``: sum_b V_b (u_b (x) delta_b - u_a (x) delta_a) . grad W_ab instead, the
+    divergence without the zeroth-order error 2 u_a (delta_a . sum_b V_b grad W_ab) of the
+    symmetric form (not the paper's printed form; see docs/ctvf.md)."""
 
-    switches = ("enabled",)
+    switches = ("enabled", "difference")
 
-    def __init__(self, dest, sources, enabled=True):
-        super().__init__(dest, sources, enabled=bool(enabled))
+    def __init__(self, dest, sources, enabled=True, difference=False):
+        super().__init__(dest, sources, enabled=bool(enabled), difference=int(bool(difference)))
 
     def loop(self, d_idx, d_au, d_av, d_aw, d_u, d_v, d_w, d_uhat, d_vhat, d_what, d_rho,
              s_idx, s_m, s_u, s_v, s_w, s_uhat, s_vhat, s_what, s_rho, DWIJ):
@@ -31,6 +34,8 @@ class TransportStress(Equation):
             dzb = s_what[s_idx] - s_w[s_idx]
             ra = 1.0 / d_rho[d_idx]
             rb = 1.0 / s_rho[s_idx]
+            if self.difference:
+                ra = -rb
             dda = (dxa * DWIJ[0] + dya * DWIJ[1] + dza * DWIJ[2]) * ra
             ddb = (dxb * DWIJ[0] + dyb * DWIJ[1] + dzb * DWIJ[2]) * rb
             mb = s_m[s_idx]

@@ -49,6 +49,10 @@ from ..equations.wcsph import BodyForce
 DENSITIES = ("summation", "continuity")
 CORRECTIONS = ("edac", "stress", "divergence", "continuity")
 SOLID_CORRECTIONS = ("edac", "continuity", "jaumann")
+# the -u div(delta) term of eq. 19 ("delta") or as eq. 27 prints it, -u div(u~) ("printed")
+DIVERGENCE_FORMS = ("delta", "printed")
+# the A term of eq. 27 in its printed symmetric form or as a difference (zeroth-order consistent)
+STRESS_FORMS = ("symmetric", "difference")
 
 
 class TransportVelocityStep(IntegratorStep):
@@ -298,7 +302,12 @@ class CTVFScheme(TransportVelocityScheme):
     Quinlan & Lastiwka 2009; not in the paper, off by default).  ``alpha``: Monaghan
     artificial viscosity (eq. 28; 0 removes it).  ``alpha_edac``: eq. 24.  ``gx, gy,
     gz``: body force.  IPST: ``ipst_tolerance``, ``ipst_max_iterations``,
-    ``ipst_interval``.  Other keywords as :class:`TransportVelocityScheme`.
+    ``ipst_interval``.  ``divergence_form``: 'delta' (eq. 19's -u div(u~ - u), default) or
+    'printed' (eq. 27 as printed, -u div u~).  ``stress_form``: 'symmetric' (eq. 27's A
+    term as printed, default) or 'difference' (the divergence of u (x) delta without the
+    symmetric form's zeroth-order error; docs/ctvf.md).  ``edac_damping``: 'consistent'
+    (default: the damping of eq. 26 as a Laplacian of p) or 'paper' (as printed, with an
+    extra 1/rho: nu_edac / rho0).  Other keywords as :class:`TransportVelocityScheme`.
 
     Free surfaces (``free_surface=True``): every evaluation at new positions identifies
     the free-surface particles and their normals (section 3.4, cone test within
@@ -309,8 +318,18 @@ class CTVFScheme(TransportVelocityScheme):
     """
 
     def __init__(self, fluids, dim, rho0, c0, nu, h, dx, umax=1.0, shifting="spst",
-                 corrections=CORRECTIONS, alpha_edac=0.5, bql=False, **kw):
+                 corrections=CORRECTIONS, alpha_edac=0.5, bql=False, divergence_form="delta",
+                 stress_form="symmetric", edac_damping="consistent", **kw):
         super().__init__(fluids, dim, rho0, c0, nu, h, dx, umax=umax, shifting=shifting, **kw)
+        if edac_damping not in ("paper", "consistent"):
+            raise ValueError(f"edac_damping must be 'paper' or 'consistent', got {edac_damping!r}")
+        self.edac_damping = edac_damping
+        if divergence_form not in DIVERGENCE_FORMS:
+            raise ValueError(f"divergence_form must be one of {DIVERGENCE_FORMS}")
+        self.divergence_form = divergence_form
+        if stress_form not in STRESS_FORMS:
+            raise ValueError(f"stress_form must be one of {STRESS_FORMS}")
+        self.stress_form = stress_form
         bad = sorted(set(corrections) - set(CORRECTIONS))
         if bad:
             raise ValueError(f"unknown correction {bad[0]!r}; known: {', '.join(CORRECTIONS)}")
@@ -322,8 +341,10 @@ class CTVFScheme(TransportVelocityScheme):
         self.continuity_correction = "continuity" in on and self.density == "continuity"
 
     def nu_edac(self):
-        """nu_edac = alpha_edac h c0 / 8 (Adepu & Ramachandran 2021, eq. 24)."""
-        return self.alpha_edac * self.h * self.c0 / 8.0
+        """nu_edac = alpha_edac h c0 / 8 (Adepu & Ramachandran 2021, eq. 24), divided by rho0
+        for the printed form of eq. 26 (``edac_damping='paper'``)."""
+        nu = self.alpha_edac * self.h * self.c0 / 8.0
+        return nu / self.rho0 if self.edac_damping == "paper" else nu
 
     def _rate_group(self):
         """Evaluation 0, at r^n with u^{n+1/2}, u~^{n+1/2}: dp/dt (eq. 26), drho/dt (eq. 25)."""
@@ -352,8 +373,10 @@ class CTVFScheme(TransportVelocityScheme):
         for d in self.fluids:
             src = self._sources(d)
             eqs += [PressureGradient(d, src, bql=self.bql)] + self._viscous_equations(d)
-            eqs += [TransportStress(d, src, enabled=self.stress_correction),
-                    MomentumTransportDivergence(d, src, enabled=self.divergence_correction)]
+            eqs += [TransportStress(d, src, enabled=self.stress_correction,
+                                    difference=self.stress_form == "difference"),
+                    MomentumTransportDivergence(d, src, enabled=self.divergence_correction,
+                                                printed=self.divergence_form == "printed")]
             eqs += self._body_force(d) + self.shift.momentum_equations(d, src)
             if self.dim == 2:
                 eqs.append(Vorticity2D(d, self._fluid_sources(d)))
@@ -523,9 +546,6 @@ class CTVFSolidScheme(ElasticSolids, CTVFScheme):
     def __init__(self, solids, dim, rho0, E, poisson, h, dx, umax=1.0, shifting="spst", alpha=1.0,
                  corrections=SOLID_CORRECTIONS, clamped=None, free_surface=True, edac_damping="paper",
                  yield_stress=None, contact=False, driven=None, **kw):
-        if edac_damping not in ("paper", "consistent"):
-            raise ValueError(f"edac_damping must be 'paper' or 'consistent', got {edac_damping!r}")
-        self.edac_damping = edac_damping
         bad = sorted(set(corrections) - set(SOLID_CORRECTIONS))
         if bad:
             raise ValueError(f"unknown solid correction {bad[0]!r}; known: {', '.join(SOLID_CORRECTIONS)}")
@@ -534,10 +554,6 @@ class CTVFSolidScheme(ElasticSolids, CTVFScheme):
         fluid_corrections = tuple(c for c in corrections if c in ("edac", "continuity"))
         super().__init__(solids, dim, rho0, c0, 0.0, h, dx, umax=umax, shifting=shifting,
                          corrections=fluid_corrections, density="continuity", alpha=alpha,
-                         free_surface=free_surface and shifting != "ipst", **kw)
+                         free_surface=free_surface and shifting != "ipst", edac_damping=edac_damping, **kw)
         self._init_solid(G, clamped or {}, "jaumann" in corrections, yield_stress, contact, driven)
 
-    def nu_edac(self):
-        """Eq. 24, divided by rho0 for the printed form of eq. 26 (``edac_damping='paper'``)."""
-        nu = super().nu_edac()
-        return nu / self.rho0 if self.edac_damping == "paper" else nu
