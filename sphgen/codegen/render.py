@@ -135,8 +135,8 @@ def source_view(plan, p, loop):
 
 def pass_view(plan, p):
     strides = register_strides(plan, p)
-    pairs = [(f"_r_{x}" + (f"[{i}]" if k > 1 else ""), f"{p.dest}_{x}[{k} * d_idx + {i}]" if k > 1
-              else f"{p.dest}_{x}[d_idx]") for x, k in strides.items() for i in range(k)]
+    pairs = [(f"_r_{r}", f"{p.dest}_{x}[{k} * d_idx + {i}]" if k > 1 else f"{p.dest}_{x}[d_idx]")
+             for x, k in strides.items() for i, r in enumerate(_rows(x, k))]
     return PassView(
         p.label, p.dest, declarations(plan, p),
         [call(ep.methods["initialize"], p.dest) for ep in p.calls("initialize")],
