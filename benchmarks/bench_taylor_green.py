@@ -28,7 +28,8 @@ def run_sphgen(nx, tf, threads, workdir, cache=None):
     """One sphgen run as a subprocess; returns its info.json plus contention."""
     out = os.path.join(workdir, f"sphgen_nx{nx}_t{threads}_{time.time_ns()}")
     exe = os.path.join(os.path.dirname(sys.executable), "sphgen")
-    cmd = [exe, "run", "taylor_green", "--nx", str(nx), "--tf", str(tf), "--disable-output",
+    # the plain lattice, as PySPH's case starts (sphgen's default start is perturbed)
+    cmd = [exe, "run", "taylor_green", "--nx", str(nx), "--tf", str(tf), "--perturb", "0", "--disable-output",
            "--no-progress", "-d", out]
     cmd += ["--no-openmp"] if threads == 1 else ["--threads", str(threads)]
     env = dict(os.environ)

@@ -2,11 +2,13 @@
 """Work-precision: L1 error of |u| (Adepu & Ramachandran (2024) eq. 66) against wall time, Taylor-Green EDAC.
 
 For nx in 25, 50, 100 (Re=100, tf=0.5) runs sphgen (2 threads) and, where a PySPH venv
-is found, PySPH 1.0b2's EDAC; prints a table and writes a log-log plot.  Both the
+is found, PySPH 1.0b2's EDAC, both from the same start: the square lattice moved by a
+uniform random ``--perturb`` dx (default 0.1, sphgen's default; ``--perturb 0`` for the
+plain lattice, PySPH's default); prints a table and writes a log-log plot.  Both the
 final-time L1 and, for sphgen, its time average over the run are reported: the
 final-time value carries acoustic oscillations of period L/c0.
 
-    python benchmarks/work_precision.py [--out outputs/work_precision] [--no-pysph]
+    python benchmarks/work_precision.py [--out outputs/work_precision] [--no-pysph] [--perturb 0.1]
         [--pysph-scheme edac --pysph-scheme gtvf] [--write-reference]
 
 ``--write-reference`` stores PySPH's points (one series per ``--pysph-scheme``) in
@@ -27,21 +29,24 @@ REFERENCE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "sphg
                          "pysph_taylor_green.json")
 
 
-def reference_points(by_scheme, tf):
+def reference_points(by_scheme, tf, perturb):
     """The reference file of ``sphgen precision`` from {scheme: [{nx, wall_s, l1}]} of PySPH runs."""
     series = {f"PySPH 1.0b2 {scheme.upper()}": [{"label": r["nx"], "wall_time": r["wall_s"], "error": r["l1"]}
                                                 for r in rows if r.get("wall_s") and r.get("l1")]
               for scheme, rows in by_scheme.items()}
-    return {"source": "PySPH 1.0b2, `pysph run taylor_green --scheme S --nx N --re 100 --tf %g`, 2 threads, "
-            "output every 50 steps; `python benchmarks/work_precision.py --write-reference`. Wall time is "
-            "PySPH's 'Run took'." % tf, "error_key": "l1_error", "tf": tf, "series": series}
+    flag = f" --perturb {perturb:g}" if perturb else ""
+    return {"source": f"PySPH 1.0b2, `pysph run taylor_green --scheme S --nx N --re 100 --tf {tf:g}{flag}`, "
+            "2 threads, output every 50 steps; `python benchmarks/work_precision.py --write-reference"
+            f"{flag}`. Wall time is PySPH's 'Run took'.", "error_key": "l1_error", "tf": tf,
+            "perturb": perturb, "series": series}
 
 
-def sphgen_case(nx, tf, out, threads=2):
+def sphgen_case(nx, tf, out, perturb, threads=2):
     d = os.path.join(out, f"sphgen_nx{nx}")
     exe = os.path.join(os.path.dirname(sys.executable), "sphgen")
     subprocess.run([exe, "run", "taylor_green", "--nx", str(nx), "--tf", str(tf), "--disable-output",
-                    "--no-progress", "--threads", str(threads), "-d", d, "--overwrite"], check=True,
+                    "--no-progress", "--threads", str(threads), "--perturb", str(perturb), "-d", d, "--overwrite"],
+                   check=True,
                    stdout=subprocess.DEVNULL)
     info = json.load(open(os.path.join(d, "info.json")))
     res = json.load(open(os.path.join(d, "results.json")))
@@ -54,13 +59,15 @@ def main(argv=None):
     p.add_argument("--out", default="outputs/work_precision")
     p.add_argument("--tf", type=float, default=0.5)
     p.add_argument("--no-pysph", action="store_true")
+    p.add_argument("--perturb", type=float, default=0.1,
+                   help="random lattice perturbation in dx, the same for both codes (default 0.1)")
     p.add_argument("--pysph-scheme", action="append", choices=("edac", "gtvf"), default=None,
                    help="PySPH scheme(s) to run (default edac)")
     p.add_argument("--write-reference", action="store_true",
                    help="store PySPH's points as the reference of `sphgen precision taylor_green`")
     o = p.parse_args(argv)
     os.makedirs(o.out, exist_ok=True)
-    rows = {"sphgen": [sphgen_case(nx, o.tf, o.out) for nx in NXS]}
+    rows = {"sphgen": [sphgen_case(nx, o.tf, o.out, o.perturb) for nx in NXS]}
     py = None if o.no_pysph else find_pysph_python()
     pysph = {}
     for scheme in (o.pysph_scheme or ["edac"]) if py else []:
@@ -68,13 +75,14 @@ def main(argv=None):
         rows[code] = pysph[scheme] = []
         for nx in NXS:
             r = run_pysph(py, nx=nx, tf=o.tf, openmp=True, threads=2, with_error=True, scheme=scheme,
-                          workdir=os.path.join(o.out, f"{code}_nx{nx}"))
+                          workdir=os.path.join(o.out, f"{code}_nx{nx}"),
+                          extra_args=["--perturb", str(o.perturb)] if o.perturb else None)
             e = r.get("error") or {}
             pysph[scheme].append({"nx": nx, "wall_s": r.get("run_s"), "l1": e.get("l1"),
                                   "max_u_rel": (e["decay"] / e["decay_ex"] - 1) if e.get("decay") else None})
     if o.write_reference and pysph:
         with open(REFERENCE, "w") as f:
-            json.dump(reference_points(pysph, o.tf), f, indent=1)
+            json.dump(reference_points(pysph, o.tf, o.perturb), f, indent=1)
     with open(os.path.join(o.out, "work_precision.json"), "w") as f:
         json.dump(rows, f, indent=1)
     print(f"{'code':8s}{'nx':>5s}{'wall s':>9s}{'L1(tf)':>9s}{'L1 mean':>9s}{'max|u| err':>12s}")

@@ -79,6 +79,7 @@ class Application:
         self.history = []
         self.restarts = []
         self.diag = None
+        self.timers = None      # sphgen.timing.Timers with --timing
 
     # ---------------------------------------------------------------- hooks
     def add_user_options(self, parser):
@@ -136,6 +137,9 @@ class Application:
         g.add_argument("--backend", choices=("cython", "python"), default="cython",
                        help="compiled (default) or the slow plain-Python evaluator")
         g.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
+        g.add_argument("--timing", action="store_true",
+                       help="after the run, print where the time loop's wall time went (per pass, stage, "
+                       "neighbour search, guard, callbacks) and keep it in info.json")
         g.add_argument("--debug", action="store_true", help="show tracebacks of errors")
 
     def parser(self):
@@ -250,6 +254,10 @@ class Application:
             self.diag.sample(self.solver.t, self.scene.arrays)
         self._write_progress()
         error = None
+        if self.options.timing:
+            from .timing import Timers
+            self.timers = Timers()
+            self.timers.attach(self.solver)
         try:
             self.solver.run()
         except SphgenError as e:
@@ -261,11 +269,17 @@ class Application:
                 self._write_progress(completed=True)
         print(f"{self.name}: {self.solver.step} steps to t={self.solver.t:.6g} in {self.solver.wall_time:.2f} s "
               f"(compile {self.scene.compile_time:.2f} s, {self.scene.threads} thread(s)); output in {outdir}")
+        if self.timers is not None:
+            print(self.timing_report()[0])
         self.post_process(outdir)
         if self.diag is not None:
             from .tools.plots import plot_series
             plot_series(os.path.join(outdir, "diagnostics.json"), os.path.join(outdir, "diagnostics.png"))
         return self._info(True)
+
+    def timing_report(self):
+        """(text, dict) of :meth:`sphgen.timing.Timers.report` for the run so far."""
+        return self.timers.report(self.solver.wall_time, self.solver.step, self.scene.threads)
 
     def _write_progress(self, completed=False, error=None):
         """info.json and history.json as they stand now (both atomic)."""
@@ -329,6 +343,7 @@ class Application:
             "neighbour_updates": sc.nnps.n_updates, "neighbour_builds": sc.nnps.n_builds,
             "generated_source": getattr(sc, "source_path", None),
             "restarts": self.restarts, "options": vars(opts),
+            **({"timing": self.timing_report()[1]} if self.timers is not None else {}),
             "finished_at": time.strftime("%Y-%m-%dT%H:%M:%S"),
         }
 

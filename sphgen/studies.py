@@ -145,6 +145,10 @@ def precision(argv):
         print(f"reference points not plotted: they measure {ref.get('error_key')} at t={ref.get('tf')}; "
               f"pass --error {ref.get('error_key')} --tf {ref.get('tf')} to compare")
         ref = None
+    if ref is not None and not _same_start(ref, rows):
+        print(f"reference points not plotted: they start from a lattice perturbed by {ref.get('perturb', 0):g} dx; "
+              f"pass --perturb {ref.get('perturb', 0):g} to compare")
+        ref = None
     _plot_precision(os.path.join(o.directory, "precision.png"), axes, rows, key, ref)
     print(text + f"table: {os.path.join(o.directory, 'precision.md')}\n"
           f"plot:  {os.path.join(o.directory, 'precision.png')}")
@@ -166,6 +170,14 @@ def _reference(path, name):
 
 def _same_tf(ref, rows):
     return all(abs(r["info"].get("t", -1) - ref.get("tf", -2)) < 1e-9 for r in rows if r["info"])
+
+
+def _same_start(ref, rows):
+    """The runs start as the reference's did (its ``perturb``, 0 if it names none), where
+    the application has a ``--perturb`` option."""
+    want = float(ref.get("perturb", 0.0))
+    return all(abs(float(r["info"]["options"]["perturb"]) - want) < 1e-12 for r in rows
+               if r["info"] and "perturb" in r["info"].get("options", {}))
 
 
 def _line_axis(axes):

@@ -63,10 +63,20 @@ def test_pysph_reference_file_has_one_series_per_scheme(tmp_path):
     from work_precision import reference_points
     from sphgen.studies import _reference
     ref = reference_points({"edac": [{"nx": 25, "wall_s": 3.0, "l1": 0.02}, {"nx": 50, "wall_s": None, "l1": 0.1}],
-                            "gtvf": [{"nx": 25, "wall_s": 4.0, "l1": 0.03}]}, 0.5)
+                            "gtvf": [{"nx": 25, "wall_s": 4.0, "l1": 0.03}]}, 0.5, 0.1)
     path = tmp_path / "ref.json"
     path.write_text(json.dumps(ref))
     back = _reference(str(path), "taylor_green")
-    assert back["error_key"] == "l1_error" and back["tf"] == 0.5
+    assert back["error_key"] == "l1_error" and back["tf"] == 0.5 and back["perturb"] == 0.1
+    assert "--perturb 0.1" in back["source"]
     assert back["series"] == {"PySPH 1.0b2 EDAC": [{"label": 25, "wall_time": 3.0, "error": 0.02}],
                               "PySPH 1.0b2 GTVF": [{"label": 25, "wall_time": 4.0, "error": 0.03}]}
+
+
+def test_reference_points_from_another_start_are_not_plotted():
+    """PySPH's points from the plain lattice are not compared with runs from a perturbed one."""
+    from sphgen.studies import _same_start
+    runs = [{"info": {"options": {"perturb": 0.1}}}, {"info": {"options": {"perturb": 0.1}}}]
+    assert _same_start({"perturb": 0.1}, runs)
+    assert not _same_start({}, runs)                    # an older file: the plain lattice
+    assert _same_start({}, [{"info": {"options": {"nr": 10}}}])   # no --perturb option: nothing to compare
