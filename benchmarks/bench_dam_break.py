@@ -12,7 +12,11 @@ passes, ~2.5x the pairs of PySPH's case) and with PySPH's physics (``--delta 0 -
 wendland --hdx 1.3``: plain WCSPH with the Wendland C2 kernel at h = 1.3 dx, as
 ``pysph run dam_break_2d``).  The second is the same-case comparison.
 
-    python benchmarks/bench_dam_break.py [--repeat 3] [--tf 0.7]
+``--dx`` sets the spacing of both codes (default 0.03, both codes' default: 3384
+particles here); at that size the serial part of a step (Python around the compiled
+loops) bounds the thread speed-up, which ``--timing`` shows (docs/performance.md).
+
+    python benchmarks/bench_dam_break.py [--repeat 3] [--tf 0.7] [--dx 0.03]
 """
 import argparse
 import csv
@@ -45,8 +49,9 @@ def sphgen_app(work, app, args, threads, label):
             "pairs_per_s": info["neighbour_pairs_per_step"] * steps / wall, "info": info}
 
 
-def sphgen_run(work, tf, threads, config="sphgen"):
-    return sphgen_app(work, "dam_break_2d", ["--tf", str(tf)] + CONFIGS[config], threads, config)
+def sphgen_run(work, tf, threads, config="sphgen", dx=None):
+    size = ["--dx", str(dx)] if dx else []
+    return sphgen_app(work, "dam_break_2d", ["--tf", str(tf)] + size + CONFIGS[config], threads, config)
 
 
 def pysph_app(py, work, app, args, threads, label="pysph"):
@@ -73,8 +78,9 @@ def particle_counts(stdout):
     return {k.strip(): int(v) for k, v in (line.split(":") for line in block.splitlines() if ":" in line)}
 
 
-def pysph_run(py, work, tf, threads):
-    return pysph_app(py, work, "dam_break_2d", ["--tf", str(tf)], threads)
+def pysph_run(py, work, tf, threads, dx=None):
+    size = ["--dx", str(dx)] if dx else []
+    return pysph_app(py, work, "dam_break_2d", ["--tf", str(tf)] + size, threads)
 
 
 def med(rows, key):
@@ -85,22 +91,24 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--tf", type=float, default=0.7)
+    ap.add_argument("--dx", type=float, default=None, help="particle spacing of both codes (default: theirs, 0.03)")
+    ap.add_argument("--no-pysph", action="store_true")
     a = ap.parse_args()
     print(f"load average before: {os.getloadavg()[0]:.2f}")
-    py = find_pysph_python()
+    py = None if a.no_pysph else find_pysph_python()
     work = tempfile.mkdtemp(prefix="sphgen_db_")
     for config in CONFIGS:
-        sphgen_run(work, 0.001, 1, config)  # compile once
+        sphgen_run(work, 0.001, 1, config, a.dx)  # compile once
     if py:
-        pysph_run(py, work, 0.001, 1)
-        pysph_run(py, work, 0.001, 2)
+        pysph_run(py, work, 0.001, 1, a.dx)
+        pysph_run(py, work, 0.001, 2, a.dx)
     res = {}
     for _ in range(a.repeat):
         for threads in (1, 2):
             for config in CONFIGS:
-                res.setdefault((config, threads), []).append(sphgen_run(work, a.tf, threads, config))
+                res.setdefault((config, threads), []).append(sphgen_run(work, a.tf, threads, config, a.dx))
             if py:
-                res.setdefault(("pysph", threads), []).append(pysph_run(py, work, a.tf, threads))
+                res.setdefault(("pysph", threads), []).append(pysph_run(py, work, a.tf, threads, a.dx))
     us = {}
     for (code, threads), rows in sorted(res.items()):
         r = rows[0]
