@@ -38,3 +38,6 @@ def test_nx100_is_more_accurate_than_nx50(tg50, tmp_path):
     res100, _ = run_tg(tmp_path, 100)
     assert res100["l1_error_mean"] < 0.8 * res50["l1_error_mean"], (res50, res100)
     assert res100["l1_error"] <= 0.06
+    # from the default perturbed start the final error falls too (0.0070 -> 0.0028 measured;
+    # on the plain lattice it did not: 0.041 -> 0.043, docs/validation.md)
+    assert res100["l1_error"] < 0.6 * res50["l1_error"], (res50, res100)
