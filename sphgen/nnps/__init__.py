@@ -20,7 +20,8 @@ import math
 
 import numpy as np
 
-from ._cell_list import (GridSpec, RowBuffers, bin_particles, build_csr, largest_motion, refine_csr, remap_csr,
+from ._cell_list import (GridSpec, RowBuffers, bin_particles, build_csr, gather_points, largest_motion,
+                          refine_csr, remap_csr,
                          scan, wrap_periodic)
 
 __all__ = ["Domain", "NeighbourSearch", "NotFrozenError"]
@@ -171,6 +172,8 @@ class NeighbourSearch:
         self._built_at = None    # positions and h at the last rebuild (with a skin)
         self._skin_lists = {}    # (dest, src) -> lists with the skin, since the rebuild
         self._scratch = {}       # (dest, src) -> int32 scratch of refine_csr
+        self._points = {}        # src -> its gather_points records, since the last update
+        self._point_buffers = {}  # src -> the float64 (n, 4) buffer they live in
         self._by_name = dict(zip(names, arrays))
         self._cache = {}
         self._frozen = {}
@@ -213,6 +216,7 @@ class NeighbourSearch:
         self.n_updates += 1
         if self._built_at is not None and self._within_skin():
             self._cache = {}
+            self._points = {}
             return
         self._build()
 
@@ -288,6 +292,7 @@ class NeighbourSearch:
                                                  self.radius_scale, skin)
             self._sizes[pa.name] = pa.n
         self._cache = {}
+        self._points = {}
         self._skin_lists = {}
         self.n_builds += 1
         if skin > 0:
@@ -386,8 +391,14 @@ class NeighbourSearch:
         scratch = self._scratch.get(key)
         if scratch is None or scratch.size < lists[1].size:
             scratch = self._scratch[key] = np.empty(int(1.25 * lists[1].size) + 16, dtype=np.int32)
-        return refine_csr(self.grid, lists[0], lists[1], self._coords(d), d.get("h"),
-                          self._coords(s), s.get("h"), self.radius_scale, scratch)
+        points = self._points.get(s.name)
+        if points is None:    # once per update for every list with this source
+            buf = self._point_buffers.get(s.name)
+            if buf is None or buf.shape[0] < s.n:
+                buf = self._point_buffers[s.name] = np.empty((max(s.n, 1), 4), dtype=np.float64)
+            points = self._points[s.name] = gather_points(self._coords(s), s.get("h"), self.radius_scale, buf)
+        return refine_csr(self.grid, lists[0], lists[1], self._coords(d), d.get("h"), points,
+                          self.radius_scale, scratch)
 
     def freeze(self, dest, src):
         """Keep the current lists of (dest, src) as the fixed reference list (Total

@@ -799,38 +799,50 @@ def remap_csr(int[::1] offsets, int[::1] nbrs, int[::1] perm_dest, int[::1] inv_
     return new_off_arr, new_nbrs_arr
 
 
+def gather_points(list coords, double[::1] h, double radius_scale, double[:, ::1] out):
+    """Fill ``out[i] = (x, y, z, (k h)**2)`` of every particle (0 on axes past ``len(coords)``):
+    the source records of :func:`refine_csr`, one cache line per two candidates."""
+    cdef Py_ssize_t n = h.shape[0], i
+    cdef int a, dim = len(coords)
+    cdef const double* x[3]
+    cdef double kh
+    if out.shape[0] < n or out.shape[1] != 4:
+        raise ValueError("gather_points: out must have (n, 4) entries")
+    for a in range(dim):
+        x[a] = _coord_ptr(coords[a], n)
+    for i in prange(n, nogil=True, schedule="static"):
+        for a in range(3):
+            out[i, a] = x[a][i] if a < dim else 0.0
+        kh = radius_scale * h[i]
+        out[i, 3] = kh * kh
+    return out
+
+
 def refine_csr(GridSpec grid, int[::1] offsets, int[::1] nbrs, list dest_coords,
-               double[::1] dest_h, list src_coords, double[::1] src_h, double radius_scale,
+               double[::1] dest_h, double[:, ::1] src_points, double radius_scale,
                int[::1] scratch):
     """The exact lists (``|r_ij| < k max(h_i, h_j)`` now) from lists with a skin.
 
     ``offsets``/``nbrs`` hold, for every destination, a superset of its neighbours (a
     list built with a skin that still covers the motion); the coordinates and ``h`` are
-    the current ones.  Each row keeps its order; the test is the one :func:`build_csr`
-    makes, term for term, so the result equals a fresh exact build.  The sources are
-    first gathered into ``(x, y, z, (k h)**2)`` records, one cache line per two
-    candidates.  ``scratch`` needs ``len(nbrs)`` entries.  Returns ``(offsets, nbrs)``."""
+    the current ones, the sources' as the records of :func:`gather_points` (gathered once
+    per update and shared by every list with that source).  Each row keeps its order;
+    the test is the one :func:`build_csr` makes, term for term, so the result equals a
+    fresh exact build.  ``scratch`` needs ``len(nbrs)`` entries.  Returns
+    ``(offsets, nbrs)``."""
     cdef const Grid* g = &grid.c
-    cdef Py_ssize_t nd = dest_h.shape[0], ns = src_h.shape[0], i, k, cnt, start
+    cdef Py_ssize_t nd = dest_h.shape[0], i, k, cnt, start
     cdef const double* xd[3]
-    cdef const double* xs[3]
     cdef const double* q
     cdef double dx, dy, dz, r2, ri2, kh
     cdef int a
     cdef int* tmp = _iptr(scratch)
     cdef int[::1] counts = np.empty(nd, dtype=np.int32)
-    cdef double[:, ::1] pts_view = np.zeros((max(ns, 1), 4), dtype=np.float64)
-    cdef double* pts = &pts_view[0, 0]
-    if offsets.shape[0] != nd + 1 or scratch.shape[0] < nbrs.shape[0]:
+    cdef const double* pts = &src_points[0, 0] if src_points.shape[0] else NULL
+    if offsets.shape[0] != nd + 1 or scratch.shape[0] < nbrs.shape[0] or src_points.shape[1] != 4:
         raise ValueError("refine_csr: the list does not fit the arrays")
     for a in range(g.dim):
         xd[a] = _coord_ptr(dest_coords[a], nd)
-        xs[a] = _coord_ptr(src_coords[a], ns)
-    for i in prange(ns, nogil=True, schedule="static"):
-        for a in range(g.dim):
-            pts[4 * i + a] = xs[a][i]
-        kh = radius_scale * src_h[i]
-        pts[4 * i + 3] = kh * kh
     cdef bint open_box = g.dim >= 2 and not (g.periodic[0] or g.periodic[1] or g.periodic[2])
     cdef double xi, yi, zi
     if open_box:  # the common case without the per-candidate axis tests; in 2D the z terms
