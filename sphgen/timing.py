@@ -31,6 +31,10 @@ class Timers:
         self.calls = OrderedDict()
         self._inner = []          # per open timed call: the time of the timed calls inside it
 
+    def reset(self):
+        self.seconds.clear()
+        self.calls.clear()
+
     def add(self, label, seconds):
         self.seconds[label] = self.seconds.get(label, 0.0) + seconds
         self.calls[label] = self.calls.get(label, 0) + 1
@@ -67,13 +71,22 @@ class Timers:
         solver.write_output = self.wrap(solver.write_output, "output files")
         solver.post_step_callbacks[:] = [self.wrap(cb, "application callbacks")
                                          for cb in solver.post_step_callbacks]
+        prepare = solver._prepare
+
+        def prepare_then_reset():     # the time loop starts after it: count from there
+            prepare()
+            self.reset()
+        solver._prepare = prepare_then_reset
 
     def table(self, loop_seconds, steps):
         """Rows ``(label, seconds, share of the loop, ms per step, calls per step)``, the
         "other" row last, and the Amdahl bound of 2 threads from the serial share."""
         steps = max(steps, 1)
-        rows = [(k, s, s / loop_seconds if loop_seconds > 0 else 0.0, 1e3 * s / steps, self.calls[k] / steps)
-                for k, s in self.seconds.items()]
+        kinds = ("pass ", "stage ", "neighbours: ")
+        order = sorted(self.seconds, key=lambda k: next((i for i, p in enumerate(kinds) if k.startswith(p)),
+                                                        len(kinds)))
+        rows = [(k, self.seconds[k], self.seconds[k] / loop_seconds if loop_seconds > 0 else 0.0,
+                 1e3 * self.seconds[k] / steps, self.calls[k] / steps) for k in order]
         counted = sum(self.seconds.values())
         other = max(loop_seconds - counted, 0.0)
         rows.append(("other (integrator, reductions, dt)", other,

@@ -79,5 +79,9 @@ def test_run_with_timing_reports_every_part(tmp_path, capsys):
     assert {"neighbours: cells", "neighbours: lists", "blow-up guard"} <= parts
     total = sum(r["seconds"] for r in timing["rows"])
     assert total == pytest.approx(info["wall_time"], rel=1e-6)
+    other = [r for r in timing["rows"] if r["part"].startswith("other")][0]
+    assert other["seconds"] > 0             # the initial accelerations are not in the loop's rows
+    passes = [r for r in timing["rows"] if r["part"].startswith("pass ")]
+    assert all(r["calls_per_step"] == pytest.approx(1.0) for r in passes)
     assert timing["steps"] == info["steps"]
     assert "2 threads can make this run at most" in printed
