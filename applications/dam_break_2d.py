@@ -199,7 +199,7 @@ class DamBreak2D(Application):
             return CTVFScheme(["fluid"], dim=2, rho0=RHO0, c0=self.c0, nu=o.nu, h=self.h, dx=self.dx,
                               umax=sqrt(2.0 * G * H), density="continuity", alpha=o.alpha, gy=-G,
                               walls=["wall"], free_surface=True, surface_pressure=o.surface_pressure,
-                              edac_damping=o.edac_damping)
+                              edac_damping=o.edac_damping, wall_alpha=bool(o.wall_alpha))
         if o.scheme == "variational":
             return VariationalScheme(["fluid"], ["wall"], dim=2, rho0=RHO0, c0=self.c0, gy=-G, kernel="K3",
                                      dx=self.dx, av_a=o.alpha, av_b=0.0, D=2.0 * G * H, r0=self.dx,
