@@ -82,6 +82,12 @@ class TransportVelocityStep(IntegratorStep):
                 d_vhat[d_idx] = d_v[d_idx] + 0.5 * dt * d_avhat[d_idx]
             if self.dim > 2:
                 d_what[d_idx] = d_w[d_idx] + 0.5 * dt * d_awhat[d_idx]
+        else:   # no homogenisation: u~ = u (the continuity and the transport terms read u~)
+            d_uhat[d_idx] = d_u[d_idx]
+            if self.dim > 1:
+                d_vhat[d_idx] = d_v[d_idx]
+            if self.dim > 2:
+                d_what[d_idx] = d_w[d_idx]
 
     def stage2(self, d_idx, d_x, d_y, d_z, d_u, d_v, d_w, d_uhat, d_vhat, d_what, d_p, d_ap,
                d_rho, d_arho, d_sd, d_asd, dt):
