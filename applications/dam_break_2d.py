@@ -33,8 +33,9 @@ the repulsive boundary particles of eq. 58 (D = 2 g H, r0 = dx); delta-SPH is no
 ``post_process`` writes ``results.json``: the toe position Z = x_toe/L against T (largest x
 of the fluid within 2 dx of the floor, ejected particles ignored,
 :func:`sphgen.tools.probes.front_position`), its largest relative deviation from Martin &
-Moyce (1952, a = 2.25 in and 1.125 in) and Koshizuka & Oka (1996) over 0.8 <= T <= 3
-(our curve interpolated at their times), the mass drift, the particles that left the
+Moyce (1952, a = 2.25 in and 1.125 in) and Koshizuka & Oka's (1996) experiment over
+0.8 <= T <= 3 and from their MPS curve (the reference of Adepu & Ramachandran's Fig. 16)
+over its whole data range T <= 2.943 (our curve interpolated at their times), the mass drift, the particles that left the
 tank, and the energy balance (kinetic + potential + Tait internal energy); ``toe.png``
 and ``energy.png`` plot them.
 """
@@ -67,6 +68,7 @@ TANK_H = 4.0 * L   # tank height (PySPH's container_height)
 RHO0 = 1000.0
 G = 9.81
 T_RANGE = (0.8, 3.0)  # where the toe is compared with the experiments
+MPS_RANGE = (0.0, 2.95)  # Koshizuka & Oka's MPS curve: its whole data range (T <= 2.943)
 
 
 def toe_scale():
@@ -197,7 +199,7 @@ class DamBreak2D(Application):
             return CTVFScheme(["fluid"], dim=2, rho0=RHO0, c0=self.c0, nu=o.nu, h=self.h, dx=self.dx,
                               umax=sqrt(2.0 * G * H), density="continuity", alpha=o.alpha, gy=-G,
                               walls=["wall"], free_surface=True, surface_pressure=o.surface_pressure,
-                              edac_damping=o.edac_damping)
+                              edac_damping=o.edac_damping, wall_alpha=bool(o.wall_alpha))
         if o.scheme == "variational":
             return VariationalScheme(["fluid"], ["wall"], dim=2, rho0=RHO0, c0=self.c0, gy=-G, kernel="K3",
                                      dx=self.dx, av_a=o.alpha, av_b=0.0, D=2.0 * G * H, r0=self.dx,
@@ -256,9 +258,11 @@ class DamBreak2D(Application):
                    "h": hist.get("h"), "c0": hist.get("c0"), "n_samples": int(rows.shape[0])}
         refs = {"martin_moyce_a2.25in": reference.martin_moyce_1952(2.25),
                 "martin_moyce_a1.125in": reference.martin_moyce_1952(1.125),
-                "koshizuka_oka": reference.koshizuka_oka_1996()}
+                "koshizuka_oka": reference.koshizuka_oka_1996(),
+                "koshizuka_oka_mps": reference.koshizuka_oka_1996_mps()}
         for name, (Tr, Zr) in refs.items():
-            dev, signed = max_rel_deviation(T[ok], Z[ok], np.asarray(Tr), np.asarray(Zr))
+            lo, hi = MPS_RANGE if name == "koshizuka_oka_mps" else T_RANGE
+            dev, signed = max_rel_deviation(T[ok], Z[ok], np.asarray(Tr), np.asarray(Zr), lo, hi)
             results[f"toe_max_rel_dev_{name}"] = dev
             results[f"toe_signed_dev_at_max_{name}"] = signed
         m0 = hist.get("m0", cols["mass_inside"][0])
@@ -277,7 +281,8 @@ class DamBreak2D(Application):
         self.plot(outdir, T, Z, refs, cols, label=f"sphgen {results['scheme'].upper()}")
         print(f"dam_break_2d: T={results['T']:.3g}  toe max deviation over {T_RANGE[0]} <= T <= {T_RANGE[1]}: "
               f"Martin-Moyce (a=2.25in) {_pct(results['toe_max_rel_dev_martin_moyce_a2.25in'])}, "
-              f"Koshizuka-Oka {_pct(results['toe_max_rel_dev_koshizuka_oka'])}; "
+              f"Koshizuka-Oka (experiment) {_pct(results['toe_max_rel_dev_koshizuka_oka'])}; over "
+              f"T <= {MPS_RANGE[1]}: Koshizuka-Oka MPS {_pct(results['toe_max_rel_dev_koshizuka_oka_mps'])}; "
               f"mass drift {results['mass_drift']:.2e}, outside {results['n_outside_final']}\n"
               f"results: {os.path.join(outdir, 'results.json')}\nfigures: {os.path.join(outdir, 'toe.png')}, "
               f"{os.path.join(outdir, 'energy.png')}")
@@ -292,7 +297,8 @@ class DamBreak2D(Application):
         ax.plot(T, Z, "k-", label=label)
         marks = {"martin_moyce_a2.25in": ("bo", "Martin & Moyce 1952 (a = 2.25 in)"),
                  "martin_moyce_a1.125in": ("bs", "Martin & Moyce 1952 (a = 1.125 in)"),
-                 "koshizuka_oka": ("r^", "Koshizuka & Oka 1996")}
+                 "koshizuka_oka": ("r^", "Koshizuka & Oka 1996 (experiment)"),
+                 "koshizuka_oka_mps": ("gv", "Koshizuka & Oka 1996 (MPS)")}
         for name, (Tr, Zr) in refs.items():
             ax.plot(Tr, Zr, marks[name][0], mfc="none", label=marks[name][1])
         ax.axvspan(*T_RANGE, color="0.93", zorder=0)

@@ -82,6 +82,12 @@ class TransportVelocityStep(IntegratorStep):
                 d_vhat[d_idx] = d_v[d_idx] + 0.5 * dt * d_avhat[d_idx]
             if self.dim > 2:
                 d_what[d_idx] = d_w[d_idx] + 0.5 * dt * d_awhat[d_idx]
+        else:   # no homogenisation: u~ = u (the continuity and the transport terms read u~)
+            d_uhat[d_idx] = d_u[d_idx]
+            if self.dim > 1:
+                d_vhat[d_idx] = d_v[d_idx]
+            if self.dim > 2:
+                d_what[d_idx] = d_w[d_idx]
 
     def stage2(self, d_idx, d_x, d_y, d_z, d_u, d_v, d_w, d_uhat, d_vhat, d_what, d_p, d_ap,
                d_rho, d_arho, d_sd, d_asd, dt):
@@ -134,7 +140,9 @@ class TransportVelocityScheme(Scheme):
 
     ``walls``: names of wall arrays (fixed particles with ``m``, ``h``, ``rho`` and unit
     ``normal`` into the fluid, stride 3); ``moving_walls``: those among them with a
-    prescribed velocity ``uw, vw, ww`` (Adepu & Ramachandran 2021, section 3.6).
+    prescribed velocity ``uw, vw, ww`` (Adepu & Ramachandran 2021, section 3.6);
+    ``wall_alpha``: the artificial viscosity acts against the walls too, with their
+    prescribed velocity (default; False leaves the walls out of it, docs/ctvf.md).
     ``free_surface``, ``surface_pressure``, ``cone_radius``: the free-surface treatment
     of sections 3.4-3.5 (see :class:`CTVFScheme`), shared by every transport scheme.
     """
@@ -146,7 +154,7 @@ class TransportVelocityScheme(Scheme):
                  density="summation", alpha=0.0, mach=None, pb=None, p_ref=None,
                  kernel="quintic", gx=0.0, gy=0.0, gz=0.0, ipst_tolerance=0.02,
                  ipst_max_iterations=10, ipst_interval=1, walls=(), moving_walls=(),
-                 free_surface=False, surface_pressure=False, cone_radius=2.0):
+                 free_surface=False, surface_pressure=False, cone_radius=2.0, wall_alpha=True):
         for name, v in (("rho0", rho0), ("c0", c0), ("h", h), ("dx", dx), ("umax", umax)):
             if not v > 0:
                 raise ValueError(f"{type(self).__name__}: {name}={v!r} must be > 0")
@@ -173,6 +181,7 @@ class TransportVelocityScheme(Scheme):
             raise ValueError("surface_pressure needs free_surface=True")
         self.free_surface, self.surface_pressure = bool(free_surface), bool(surface_pressure)
         self.cone_radius = cone_radius
+        self.wall_alpha = bool(wall_alpha)
         # weak compressibility assumes Mach << 1: a particle at Mach 1 means the run blew up
         self.speed_limit = c0
         skip = {1: ("y", "z", "v", "w"), 2: ("z", "w"), 3: ()}[self.dim]
@@ -216,8 +225,10 @@ class TransportVelocityScheme(Scheme):
                ArtificialViscosity(dest, src, alpha=self.alpha, c0=self.c0)]
         if self.walls:
             eqs.append(WallViscosity(dest, self.walls, nu=self.nu, dim=self.dim))
-            eqs += [WallArtificialViscosity(dest, [w], alpha=self.alpha, c0=self.c0,
-                                            moving=w in self.moving_walls, dim=self.dim) for w in self.walls]
+            if self.wall_alpha:
+                eqs += [WallArtificialViscosity(dest, [w], alpha=self.alpha, c0=self.c0,
+                                                moving=w in self.moving_walls, dim=self.dim)
+                        for w in self.walls]
         return eqs
 
     def _shift_groups(self):

@@ -470,3 +470,24 @@ def test_fluid_scheme_edac_damping_and_form_options():
     for bad in (dict(edac_damping="printed"), dict(divergence_form="u"), dict(stress_form="x")):
         with pytest.raises(ValueError):
             CTVFScheme(["fluid"], **kw, **bad)
+
+
+def test_step_without_shifting_sets_the_transport_velocity_to_u():
+    """With no homogenisation (``--shifting none``) the kick leaves u~ = u, which the
+    continuity equation and the transport terms read (before, nothing set u~ and such a
+    run with continuity density stopped at start-up)."""
+    from sphgen.schemes.ctvf import TransportVelocityStep
+    n, dt = 3, 0.1
+    a = {k: np.zeros(n) for k in ("u", "v", "w", "uhat", "vhat", "what", "auhat", "avhat", "awhat")}
+    a.update(u=np.array([1.0, 2.0, 3.0]), v=np.array([-1.0, 0.5, 0.0]),
+             au=np.array([2.0, 0.0, -4.0]), av=np.array([0.0, 2.0, 0.0]), aw=np.zeros(n),
+             auhat=np.full(n, 7.0), avhat=np.full(n, 7.0))
+    for shift in (False, True):
+        b = {k: v.copy() for k, v in a.items()}
+        step = TransportVelocityStep(2, shift=shift)
+        for i in range(n):
+            step.stage1(i, *(b[k] for k in ("u", "v", "w", "au", "av", "aw", "uhat", "vhat", "what",
+                                            "auhat", "avhat", "awhat")), dt)
+        assert np.allclose(b["u"], a["u"] + 0.5 * dt * a["au"]) and np.allclose(b["v"], a["v"] + 0.5 * dt * a["av"])
+        extra = 0.5 * dt * 7.0 if shift else 0.0
+        assert np.allclose(b["uhat"], b["u"] + extra) and np.allclose(b["vhat"], b["v"] + extra)

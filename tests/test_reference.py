@@ -37,13 +37,18 @@ def test_dam_break_fronts():
         assert np.all(np.diff(Tm) > 0) and np.all(np.diff(Zm) > 0) and np.all(Zm > 1)
     assert np.array_equal(reference.martin_moyce_1952()[0], reference.martin_moyce_1952(2.25)[0])
     assert np.all(np.diff(T) > 0) and np.all(np.diff(Z) > 0)
+    Tm, Zm = reference.koshizuka_oka_1996_mps()     # the MPS curve of Adepu & Ramachandran's Fig. 16
+    assert Tm.shape == Zm.shape == (18,) and Tm[0] == 0.0 and Zm[0] == 1.002
+    assert Tm[-1] == 2.943 and Zm[-1] == 3.997      # the front at the far wall of the 4L tank
+    assert np.all(np.diff(Tm) > 0) and np.all(np.diff(Zm) > 0)
+    assert np.all(np.interp(T[2:-1], Tm, Zm) > Z[2:-1])   # from T = 0.77 the computation runs ahead of the experiment
     with pytest.raises(ValueError, match="Martin"):
         reference.martin_moyce_1952(1.0)
 
 
 def test_every_file_names_its_source():
     files = sorted(glob.glob(os.path.join(reference.DATA_DIR, "*.csv")))
-    assert len(files) == 5
+    assert len(files) == 6
     for f in files:
         text = reference.source(os.path.basename(f))
         assert "Source:" in text and "How obtained:" in text and "doi:" in text

@@ -124,3 +124,17 @@ def test_walls_need_normals():
         s.setup_properties([fluid, wall])
     with pytest.raises(ValueError, match="moving_walls"):
         CTVFScheme(["fluid"], dim=2, rho0=1.0, c0=10.0, nu=0.01, h=DX, dx=DX, walls=["wall"], moving_walls=["lid"])
+
+
+def test_wall_alpha_switch():
+    """``wall_alpha=False`` leaves the walls out of the artificial viscosity (and only that)."""
+    def names(**kw):
+        s = CTVFScheme(["fluid"], dim=2, rho0=1.0, c0=10.0, nu=0.01, h=DX, dx=DX, walls=["wall"],
+                       density="continuity", alpha=0.1, gy=-1.0, **kw)
+        def flat(x):
+            return [e for y in x for e in flat(y)] if isinstance(x, list) else \
+                [type(e).__name__ for e in x.equations]
+        return flat(s.get_equations())
+    on, off = names(), names(wall_alpha=False)
+    assert "WallArtificialViscosity" in on and "WallArtificialViscosity" not in off
+    assert [n for n in on if n != "WallArtificialViscosity"] == off

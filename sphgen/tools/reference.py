@@ -42,8 +42,15 @@ def ghia_1982(re):
 
 
 def koshizuka_oka_1996():
-    """Koshizuka & Oka (1996) dam-break toe: (T = t sqrt(2g/L), Z = x_front/L)."""
+    """Koshizuka & Oka (1996) dam-break toe, experiment: (T = t sqrt(2g/L), Z = x_front/L)."""
     d = read_csv("koshizuka_oka_1996_dam_break_front.csv")
+    return d["T"], d["Z"]
+
+
+def koshizuka_oka_1996_mps():
+    """Koshizuka & Oka (1996) dam-break toe, their MPS simulation (Adepu & Ramachandran 2021,
+    Fig. 16's reference): (T = t sqrt(2g/L), Z = x_front/L)."""
+    d = read_csv("koshizuka_oka_1996_mps_dam_break_front.csv")
     return d["T"], d["Z"]
 
 
