@@ -1,4 +1,4 @@
-"""The linearised rates of the thermo-elastic applications (applications/thermo_modes.py):
+"""The linearised rates of the thermo-elastic applications (applications/_thermo_modes.py):
 the TVD-RK2 amplification function, the Jacobian's consistency with the compiled rates, and
 its null direction (a uniform velocity shift at the same internal energy, E + rho v . dv,
 changes no strain rate: the rows of F, H and J)."""
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from sphgen.applications.thermo_disk import ThermoDisk
-from sphgen.applications.thermo_modes import (fast_mode_amplification, rate_jacobian, rates,
+from sphgen.applications._thermo_modes import (fast_mode_amplification, rate_jacobian, rates,
                                               rk2_amplification, state_vector)
 
 

@@ -6,7 +6,7 @@ the wave speeds are held (they are frozen over a step, Algorithm 1).  The Jacobi
 central differences of the compiled rates (state update, then the rate equations with the
 angular-momentum projection if on).  Usage (one thread):
 
-    python -m sphgen.applications.thermo_modes thermo_disk --dx 1 --tf 7 --cfl 0.25 [app options]
+    python -m sphgen.applications._thermo_modes thermo_disk --dx 1 --tf 7 --cfl 0.25 [app options]
         [--alphas 0.25 0.3] [--without-projection]
 
 runs the application to --tf, then prints for each alpha_CFL the largest |1 + z + z^2/2|,
@@ -91,20 +91,17 @@ def main(argv=None):
     p.add_argument("--without-projection", action="store_true",
                    help="linearise the rates without the angular-momentum projection (same state)")
     o, rest = p.parse_known_args(argv)
-    import importlib
-    module = importlib.import_module(f"sphgen.applications.{o.app}")
-    app_class = next(c for c in vars(module).values()
-                     if isinstance(c, type) and c.__module__ == module.__name__ and hasattr(c, "tf"))
-    app = app_class()
+    from sphgen.app import load_application
+    app = load_application(o.app)()
     app.run(["--no-progress", "--disable-output", "--threads", "1", *rest])
     if app.options.form != "E" or app.options.variant == "reduced":
-        raise SystemExit("thermo_modes: the E-form full scheme only (unknowns v, F, H, J, E)")
+        raise SystemExit("_thermo_modes: the E-form full scheme only (unknowns v, F, H, J, E)")
     if o.without_projection:
         from sphgen.equations import thermo_upwind
         thermo_upwind.AngularMomentumProjection.reduce = lambda self, dst, t, dt: None
     lam = np.linalg.eigvals(rate_jacobian(app))
     dt_per_alpha = app.scheme.dx / app.scheme.max_wave_speed()
-    print(f"thermo_modes: {o.app} at t = {app.solver.t:.4g}, {lam.size} modes, h_min / c_p,max = "
+    print(f"_thermo_modes: {o.app} at t = {app.solver.t:.4g}, {lam.size} modes, h_min / c_p,max = "
           f"{dt_per_alpha:.4g} s{' (linearised without the projection)' if o.without_projection else ''}")
     for a, (g, z) in fast_mode_amplification(lam, dt_per_alpha, o.alphas).items():
         print(f"  alpha_CFL {a:g}: largest |1 + z + z^2/2| over the fast modes {g:.5f} at z = {z:.4f}")
