@@ -39,7 +39,7 @@ class ThermoSolid(Application):
     history_columns = ("t", "L_x", "L_y", "L_z", "A_x", "A_y", "A_z", "sum_V_abs_p", "kinetic", "internal",
                        "total", "ballistic", "entropy", "W_ext", "Q_in", "E_Dir", "J_min", "theta_min",
                        "theta_max", "probe_vx", "probe_vy", "probe_vz", "probe_ux", "probe_uy", "probe_uz",
-                       "probe_theta", "probe_P11")
+                       "probe_theta", "probe_P11", "W_proj", "S_proj")
 
     def add_scheme_options(self, group, variant_help):
         """The scheme's options; ``variant_help`` says why the default variant is the default."""
@@ -124,7 +124,8 @@ class ThermoSolid(Application):
         self.history.append([solver.t, *L, *A, float(np.sum(pa.V * np.linalg.norm(p, axis=1))),
                              e["kinetic"], e["internal"], e["total"], e["ballistic"], e["entropy"],
                              e["W_ext"], e["Q_in"], e["E_Dir"], float(pa.J.min()), float(pa.theta.min()),
-                             float(pa.theta.max()), pa.u[i], pa.v[i], pa.w[i], *u, pa.theta[i], pa.P[9 * i]])
+                             float(pa.theta.max()), pa.u[i], pa.v[i], pa.w[i], *u, pa.theta[i], pa.P[9 * i],
+                             e["W_proj"], e["S_proj"]])
 
     def history_meta(self):
         o = self.options
@@ -190,7 +191,10 @@ def checks(columns, rows, free_from, law_from=0.0):
     at t = 0): L drift over max sum V|p|; A drift from ``free_from`` relative to |A|; the
     energy-budget residual over max_t(K + |W_ext| + |Q_in| + |E_Dir|) and the spread of
     E_tot from ``free_from`` on the same scale; from ``law_from``, the largest fall of S and
-    the largest rise of B between rows, each over |its change| in that phase."""
+    the largest rise of B between rows, each over |its change| in that phase; the entropy the
+    angular-momentum projection took in that phase (``entropy_projection``, E-form) and the
+    largest fall of S - S_proj (``entropy_fall_without_projection``: what the paper's proof,
+    eqs. 61-65, covers; it has no projection term)."""
     c = columns_of(columns, rows)
     L = np.stack([c["L_x"], c["L_y"], c["L_z"]], 1)
     A = np.stack([c["A_x"], c["A_y"], c["A_z"]], 1)
@@ -207,10 +211,15 @@ def checks(columns, rows, free_from, law_from=0.0):
         out["total_spread"] = float(np.ptp(c["total"][free]) / scale)
     law = c["t"] >= law_from - 1e-12
     S, B = c["entropy"][law], c["ballistic"][law]
-    out.update(dict.fromkeys(("entropy_rise", "entropy_fall", "ballistic_drop", "ballistic_rise")))
+    out.update(dict.fromkeys(("entropy_rise", "entropy_fall", "ballistic_drop", "ballistic_rise",
+                              "entropy_projection", "entropy_fall_without_projection")))
     if S.size > 1:
         out["entropy_rise"] = float(S[-1] - S[0])
-        out["entropy_fall"] = float(max(0.0, -np.diff(S).min()) / abs(S[-1] - S[0])) if S[-1] != S[0] else 0.0
+        out["entropy_fall"] = largest_fall(S)
+        if "S_proj" in c:
+            Sp = c["S_proj"][law]
+            out["entropy_projection"] = float(Sp[-1] - Sp[0])
+            out["entropy_fall_without_projection"] = largest_fall(S - Sp)
         out["ballistic_drop"] = float(B[0] - B[-1])
         out["ballistic_rise"] = float(max(0.0, np.diff(B).max()) / abs(B[-1] - B[0])) if B[-1] != B[0] else 0.0
     out["W_ext"] = float(c["W_ext"][-1])
@@ -220,6 +229,11 @@ def checks(columns, rows, free_from, law_from=0.0):
     out["probe_v"] = [float(c[f"probe_v{k}"][-1]) for k in "xyz"]
     out["probe_u"] = [float(c[f"probe_u{k}"][-1]) for k in "xyz"]
     return out
+
+
+def largest_fall(S):
+    """The largest fall of S between successive rows over |S(end) - S(start)| (0 if S never falls)."""
+    return float(max(0.0, -np.diff(S).min()) / abs(S[-1] - S[0])) if S[-1] != S[0] else 0.0
 
 
 def relative_l2_in_time(t1, f1, t2, f2):

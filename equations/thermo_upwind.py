@@ -401,14 +401,23 @@ class AngularMomentumProjection(Equation):
     """The least-squares correction of the internal forces that conserves linear and angular
     momentum, Ghavamian et al. (2021) eqs. 79-82, read per unit reference volume:
     t^_a = t_a + lambda_ang x X_a + lambda_lin with sum V t^ = 0 and sum V X x t^ = 0,
-    X = ``xc`` (x^n in the first Runge-Kutta stage, the predicted x^{n+1} in the second)."""
+    X = ``xc`` (x^n in the first Runge-Kutta stage, the predicted x^{n+1} in the second).
+    It also records in the array constant ``proj`` the stage's power of the correction,
+    sum V v . dt^, and (E-form, ``form`` 0) its entropy rate -sum V v . dt^ / theta: E is
+    untouched, so the kinetic energy it adds comes out of heat (eta-form: eta is untouched)."""
+
+    switches = ("form",)
 
     def reduce(self, dst, t, dt):
         V = dst.V
         X = dst.xc.reshape(-1, 3)
         T = dst.tint.reshape(-1, 3)
         lam = projection_multipliers(V, X, T)
-        T += np.cross(lam[:3], X) + lam[3:]
+        dT = np.cross(lam[:3], X) + lam[3:]
+        T += dT
+        power = V * np.einsum("ai,ai->a", np.stack([dst.u, dst.v, dst.w], 1), dT)
+        dst.proj[0] = float(np.sum(power))
+        dst.proj[1] = -float(np.sum(power / dst.theta)) if self.form == 0 else 0.0
 
 
 def skew(x):

@@ -264,6 +264,7 @@ class ThermoRK2(Integrator):
         self.scene.stage("stage1", t, dt)
         p1 = self.apply_loads(t)
         self.compute_accelerations(0, t, dt)
+        q1 = self._projection_rates()
         self._rk(0.0)
         self.scene.stage("stage2", t, dt)
         r1 = self.impose(t + dt)
@@ -271,6 +272,7 @@ class ThermoRK2(Integrator):
         self.state(1, t + dt, dt, f"after the first stage of step {self.step_count + 1}")
         p2 = self.apply_loads(t + dt)
         self.compute_accelerations(0, t + dt, dt)
+        q2 = self._projection_rates()
         self._rk(0.5)
         self.scene.stage("stage2", t, dt)
         r3 = self.impose(t + dt)
@@ -279,7 +281,18 @@ class ThermoRK2(Integrator):
             w = 0.5 * dt * (p1.get(name, (0.0, 0.0))[0] + p2.get(name, (0.0, 0.0))[0])
             q = 0.5 * dt * (p1.get(name, (0.0, 0.0))[1] + p2.get(name, (0.0, 0.0))[1])
             self._budget(name, w, q, 0.5 * r1.get(name, 0.0) + r3.get(name, 0.0))
+        for pa in self._arrays():     # the projection's work and entropy, RK2-consistently
+            pa.proj[2:] += 0.5 * dt * (q1[pa.name] + q2[pa.name])
         self.step_count += 1
+
+    def _projection_rates(self):
+        """(power, entropy rate) of the angular-momentum projection in the stage just
+        evaluated (zero without it)."""
+        out = {}
+        for pa in self._arrays():
+            out[pa.name] = pa.proj[:2].copy()
+            pa.proj[:2] = 0.0
+        return out
 
 
 class ThermoUpwindScheme(Scheme):
@@ -403,6 +416,8 @@ class ThermoUpwindScheme(Scheme):
             pa.add_constant("mat", mat.constants())
             if "budget" not in pa.constants:
                 pa.add_constant("budget", np.zeros(3))
+            if "proj" not in pa.constants:
+                pa.add_constant("proj", np.zeros(4))     # the projection: stage power, entropy rate; W, S
             if "rk" not in pa.constants:
                 pa.add_constant("rk", np.zeros(1))       # the weight of U^n in a stage of eq. 77
         missing = [b for b in self.bodies if b not in self.arrays]
@@ -425,7 +440,7 @@ class ThermoUpwindScheme(Scheme):
                                           dissipation=self.dissipation, external=ext,
                                           volumetric=self.volumetric, se=self.se)], reference=True)]
             if self.projection:
-                rates.append(Group([AngularMomentumProjection(b)]))
+                rates.append(Group([AngularMomentumProjection(b, form=form)]))
             vol = self.volumetric
             state.append(Group([ThermoState(b, model=model, form=form, reduced=red, volumetric=vol)]))
             state_speeds.append(Group([ThermoState(b, model=model, form=form, reduced=red, volumetric=vol),
@@ -467,9 +482,11 @@ class ThermoUpwindScheme(Scheme):
     def energies(self, arrays):
         """Kinetic K, internal U, total E_tot = sum V E, entropy S = sum V eta, ballistic
         B = E_tot - theta_R S (eqs. 33, 41), and the accumulated external work W_ext, heat
-        input Q_in and energy injected by temperature resets E_Dir."""
+        input Q_in and energy injected by temperature resets E_Dir; W_proj and S_proj: the
+        kinetic energy given and the entropy taken (E-form) by the angular-momentum
+        projection (eqs. 79-82; outside the entropy proof of eqs. 61-65)."""
         out = dict.fromkeys(("kinetic", "internal", "total", "entropy", "ballistic",
-                             "W_ext", "Q_in", "E_Dir"), 0.0)
+                             "W_ext", "Q_in", "E_Dir", "W_proj", "S_proj"), 0.0)
         for pa in arrays:
             if pa.name not in self.bodies:
                 continue
@@ -486,4 +503,6 @@ class ThermoUpwindScheme(Scheme):
             out["W_ext"] += float(b[0])
             out["Q_in"] += float(b[1])
             out["E_Dir"] += float(b[2])
+            out["W_proj"] += float(pa.proj[2])
+            out["S_proj"] += float(pa.proj[3])
         return out
