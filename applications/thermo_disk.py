@@ -45,6 +45,7 @@ class ThermoDisk(ThermoSolid):
     tf = 10.0
     pfreq = 500
     default_variant = "full"
+    default_cfl = 0.25  # below the limited jumps' limit 0.28 at dx = 1 (docs/thermo.md, "Decision (disk time step)")
     probe_point = (2.0, 4.0, 0.0)
 
     def add_user_options(self, group):
