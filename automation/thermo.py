@@ -89,7 +89,8 @@ def lblock_cases(cfg):
 
 def disk_cases(cfg):
     """Every level in the E and eta forms; ablations at the coarsest: raw jumps, no projection,
-    S^E of eq. 76 (``--SE matched``)."""
+    S^E of eq. 76 (``--SE matched``); all at the disk's default alpha_CFL = 0.25 (not the
+    paper's 0.3: docs/thermo.md, "Decision (disk time step)")."""
     out_at = ["--output-at", *map(str, _times(DISK_TIMES))]
     out = {f"disk_{form}_dx{_dx_label(dx)}": ("thermo_disk", ["--dx", dx, "--form", form, *out_at])
            for dx in cfg["disk_dx"] for form in ("E", "eta")}
