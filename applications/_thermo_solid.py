@@ -25,16 +25,18 @@ VARIANTS = {"full": dict(reduced=False, dissipation=True), "reduced": dict(reduc
             "full-no-DJ": dict(reduced=False, dissipation="p"),
             "full-vol": dict(reduced=False, dissipation=True, dj="volumetric")}
 
+PAPER_CFL = 0.3     # alpha_CFL of eq. 78, the paper's
+
 
 class ThermoSolid(Application):
     """Base of the sec. 7 applications of Ghavamian et al. (2021): subclasses set
-    ``default_variant``, ``default_jumps``, ``default_projection``, ``default_cfl``, ``probe_point`` and build
-    particles and loads."""
+    ``default_variant``, ``default_jumps``, ``default_projection``, ``default_cfl``,
+    ``probe_point`` and build particles and loads."""
 
     dim = 3
     default_variant = "full"
     default_jumps = "limited"
-    default_cfl = 0.3  # alpha_CFL of eq. 78, the paper's
+    default_cfl = PAPER_CFL
     default_projection = True
     probe_point = (0.0, 0.0, 0.0)
     history_columns = ("t", "L_x", "L_y", "L_z", "A_x", "A_y", "A_z", "sum_V_abs_p", "kinetic", "internal",
@@ -65,8 +67,9 @@ class ThermoSolid(Application):
                            help="E-form temperature dissipation S^E: zero (default; S^E = 0) or matched "
                                 "(eq. 76, guarded: 0 at equal temperatures and for a negative bracket, "
                                 "capped at the pair's conductance; docs/thermo.md)")
+        papers = "" if self.default_cfl == PAPER_CFL else f"; the paper's {PAPER_CFL}"
         group.add_argument("--cfl", type=float, default=self.default_cfl,
-                           help="alpha_CFL of eq. 78 (default %(default)s; the paper's 0.3)")
+                           help=f"alpha_CFL of eq. 78 (default %(default)s{papers})")
         group.add_argument("--perturb", type=float, default=0.0,
                            help="random perturbation of the reference lattice in units of dx (default 0)")
         group.add_argument("--seed", type=int, default=1, help="seed of the perturbation (default 1)")

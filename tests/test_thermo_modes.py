@@ -20,7 +20,7 @@ def test_rk2_amplification_is_heuns():
 
 @pytest.fixture(scope="module")
 def small_disk(tmp_path_factory):
-    """A disk of radius 2 at dx = 1 (24 particles), spun and heated for 0.05 s (6 steps), so
+    """A disk of radius 2 at dx = 1 (24 particles), spun and heated for 0.05 s (7 steps), so
     that no jump is zero (the limiter's minmod has a kink at a zero jump)."""
     app = ThermoDisk()
     app.run(["-d", str(tmp_path_factory.mktemp("modes")), "--no-progress", "--disable-output", "--threads", "1",
