@@ -1,6 +1,6 @@
 """Elastic solids with CTVF, Adepu & Ramachandran (2021) sections 4.4-4.7, Figs. 18-29, Table 1.
 
-Five problems, each with the paper preset and a ``quick`` one (coarse and short: the
+Six problems, each with the paper preset and a ``quick`` one (coarse and short: the
 whole quick set runs in a few minutes on one core; it checks the pipeline, not the
 physics):
 
@@ -9,6 +9,7 @@ physics):
   H = 0.01 (Fig. 20); particles at the separation time, tip y(t), ``summary.json``.
 * ``ctvf_table1_plate``: CTVF + SPST over V_f = 0.001, 0.01, 0.03, 0.05; the period of
   the tip against Table 1 (``table1.md``, ``table1.json``, ``table1_period.png``).
+* ``ctvf_fig21_plate_ipst``: CTVF + IPST with 10, 20, 30 particles across H; tip y(t).
 * ``ctvf_fig23_uniaxial``: the uniaxial compression (``sphgen run uniaxial_compression``)
   at dx = 0.5, 1, 2 mm with CTVF and 1 mm with GTVF; von Mises stress at A against t.
 * ``ctvf_figs24-28_rings``: the colliding rings (``sphgen run rings``): nu = 0.3975 and
@@ -28,7 +29,7 @@ import numpy as np
 
 from sphgen.tools.plots import particle_panels
 
-from .tasks import SphgenProblem, Simulation
+from .tasks import SphgenProblem, Simulation, paper_and_quick
 
 VF = (0.001, 0.01, 0.03, 0.05)
 """V_f of Table 1 (Adepu & Ramachandran 2021)."""
@@ -37,6 +38,7 @@ PRESETS = {
     "paper": dict(
         plate=dict(nh=10, tf=0.3, separation_time=0.22, tf_thin=0.6, separation_time_thin=0.51),
         table1=dict(nh=10, tf=0.3),
+        fig21=dict(nh=(10, 20, 30), tf=1.0),
         uniaxial=dict(dx=(0.0005, 0.001, 0.002), gtvf_dx=0.001, tf=0.002),
         rings=dict(dx=0.001, tf=0.016, pfreq=2000),
         impact=dict(dx=0.0005, tf=8e-6, pfreq=135),
@@ -44,8 +46,9 @@ PRESETS = {
     "quick": dict(
         plate=dict(nh=4, tf=0.02, separation_time=0.01, tf_thin=0.02, separation_time_thin=0.01),
         table1=dict(nh=4, tf=0.2),
+        fig21=dict(nh=(4, 6), tf=0.02),
         uniaxial=dict(dx=(0.005, 0.01), gtvf_dx=0.01, tf=2e-4),
-        rings=dict(dx=0.004, tf=0.004, pfreq=100),
+        rings=dict(dx=0.004, tf=0.016, pfreq=400),
         impact=dict(dx=0.001, tf=8e-6, pfreq=70),
     ),
 }
@@ -68,6 +71,11 @@ def _read(folder, name):
             return json.load(f)
     except (OSError, ValueError):
         return None
+
+
+def _dump(out_dir, name, obj):
+    with open(os.path.join(out_dir, name), "w") as fh:
+        json.dump(obj, fh, indent=1)
 
 
 def _rows(folder):
@@ -159,8 +167,7 @@ def plate_figures(sim_dir, out_dir, cfg):
             particle_panels(os.path.join(out_dir, fig), have)
     overlay(os.path.join(out_dir, "plate_tip.png"), tips, "t [s]", "tip y [m]",
             "oscillating plate, V_f = 0.05: tip of the centre line")
-    with open(os.path.join(out_dir, "summary.json"), "w") as fh:
-        json.dump(summary, fh, indent=1)
+    _dump(out_dir, "summary.json", summary)
     return summary
 
 
@@ -193,8 +200,7 @@ def table1_figures(sim_dir, out_dir, cfg):
                      f"{r['period_thin_plate']:.4f} s | {r['separated']} |")
     with open(os.path.join(out_dir, "table1.md"), "w") as fh:
         fh.write("\n".join(lines) + "\n")
-    with open(os.path.join(out_dir, "table1.json"), "w") as fh:
-        json.dump(rows, fh, indent=1)
+    _dump(out_dir, "table1.json", rows)
     plt = _plt()
     fig, ax = plt.subplots(figsize=(5.5, 4))
     ax.semilogx(VF, [PERIOD_PAPER[v] for v in VF], "ks--", label="CTVF, Table 1")
@@ -210,6 +216,28 @@ def table1_figures(sim_dir, out_dir, cfg):
     overlay(os.path.join(out_dir, "table1_tip.png"), tips, "t [s]", "tip y / (V_f c0) [s]",
             "CTVF + SPST, tip displacement scaled by the initial tip speed")
     return rows
+
+
+def fig21_cases(cfg):
+    """{name: params} of ``ctvf_fig21_plate_ipst``: CTVF + IPST, V_f = 0.05, nh across H."""
+    return {f"ipst_nh{n}": dict(shifting="ipst", nh=n, tf=cfg["tf"], threads=1, pfreq=1000000) for n in cfg["nh"]}
+
+
+def fig21_figures(sim_dir, out_dir, cfg):
+    """fig21_ipst_convergence.png (tip y against t for each resolution), summary.json."""
+    os.makedirs(out_dir, exist_ok=True)
+    series, summary = [], {}
+    for name, p in fig21_cases(cfg).items():
+        folder = os.path.join(sim_dir, name)
+        res, rows = _read(folder, "results.json"), _rows(folder)
+        if res is None or rows is None:
+            continue
+        summary[name] = {k: res[k] for k in ("t", "dx", "period", "period_from", "period_paper", "separated")}
+        series.append((f"{p['nh']} across H (dx = {res['dx'] * 1e3:.3g} mm)", rows[:, 0], rows[:, 1]))
+    overlay(os.path.join(out_dir, "fig21_ipst_convergence.png"), series, "t [s]", "tip y [m]",
+            "Fig. 21: CTVF + IPST, V_f = 0.05, L = 0.2, H = 0.02")
+    _dump(out_dir, "summary.json", summary)
+    return summary
 
 
 # ------------------------------------------------------------------ uniaxial compression
@@ -236,8 +264,7 @@ def uniaxial_figures(sim_dir, out_dir, cfg):
         ramp = (rows[:, 0] * 1e3, rows[:, 2] / 1e3, "E V t / ((1 - nu^2) H)")
     overlay(os.path.join(out_dir, "fig23_von_mises.png"), series, "t [ms]", "von Mises stress at A [kPa]",
             "Fig. 23 (Das & Cleary's curves not shipped: the free-side plane-strain ramp instead)", ramp)
-    with open(os.path.join(out_dir, "summary.json"), "w") as fh:
-        json.dump(summary, fh, indent=1)
+    _dump(out_dir, "summary.json", summary)
     return summary
 
 
@@ -287,8 +314,7 @@ def ring_figures(sim_dir, out_dir, cfg):
             "colliding rings: total energy")
     overlay(os.path.join(out_dir, "rings_gap.png"), gap, "t [ms]", "gap between the rings / dx",
             "colliding rings: in contact below 1 dx")
-    with open(os.path.join(out_dir, "summary.json"), "w") as fh:
-        json.dump(summary, fh, indent=1)
+    _dump(out_dir, "summary.json", summary)
     return summary
 
 
@@ -325,8 +351,7 @@ def impact_figures(sim_dir, out_dir, cfg):
                      f"{100 * r['hole_error']:+.1f} % |")
     with open(os.path.join(out_dir, "summary.md"), "w") as fh:
         fh.write("\n".join(lines) + "\n")
-    with open(os.path.join(out_dir, "summary.json"), "w") as fh:
-        json.dump(summary, fh, indent=1)
+    _dump(out_dir, "summary.json", summary)
     return summary
 
 
@@ -338,6 +363,8 @@ SECTIONS = {
                "summary.json")),
     "table1": ("ctvf_table1_plate", "oscillating_plate", table1_cases, table1_figures,
                ("table1.md", "table1.json", "table1_period.png", "table1_tip.png")),
+    "fig21": ("ctvf_fig21_plate_ipst", "oscillating_plate", fig21_cases, fig21_figures,
+              ("fig21_ipst_convergence.png", "summary.json")),
     "uniaxial": ("ctvf_fig23_uniaxial", "uniaxial_compression", uniaxial_cases, uniaxial_figures,
                  ("fig23_von_mises.png", "summary.json")),
     "rings": ("ctvf_figs24-28_rings", "rings", ring_cases, ring_figures,
@@ -368,22 +395,15 @@ class _CTVFSolidSection(SphgenProblem):
         SECTIONS[self.section][3](self.input_path(), self.output_path(), PRESETS[self.preset][self.section])
 
 
-def _section(name, section, doc):
-    paper = type(name, (_CTVFSolidSection,), {"section": section, "__doc__": doc, "__module__": __name__})
-    quick = type(name + "Quick", (paper,), {"preset": "quick", "__doc__": doc + " (quick preset)",
-                                             "__module__": __name__})
-    return paper, quick
-
-
-CTVFPlate, CTVFPlateQuick = _section("CTVFPlate", "plate", "Adepu & Ramachandran (2021), Figs. 18-20")
-CTVFPlateTable1, CTVFPlateTable1Quick = _section("CTVFPlateTable1", "table1", "Adepu & Ramachandran (2021), Table 1")
-CTVFUniaxial, CTVFUniaxialQuick = _section("CTVFUniaxial", "uniaxial", "Adepu & Ramachandran (2021), Fig. 23")
-CTVFRings, CTVFRingsQuick = _section("CTVFRings", "rings", "Adepu & Ramachandran (2021), Figs. 24-28")
-CTVFImpact, CTVFImpactQuick = _section("CTVFImpact", "impact", "Adepu & Ramachandran (2021), Fig. 29")
-
-PAPER_PROBLEMS = [CTVFPlate, CTVFPlateTable1, CTVFUniaxial, CTVFRings, CTVFImpact]
-QUICK_PROBLEMS = [CTVFPlateQuick, CTVFPlateTable1Quick, CTVFUniaxialQuick, CTVFRingsQuick, CTVFImpactQuick]
-
+CLASS_NAMES = {"plate": ("CTVFPlate", "Figs. 18-20"), "table1": ("CTVFPlateTable1", "Table 1"),
+               "fig21": ("CTVFPlateIPST", "Fig. 21"), "uniaxial": ("CTVFUniaxial", "Fig. 23"),
+               "rings": ("CTVFRings", "Figs. 24-28"), "impact": ("CTVFImpact", "Fig. 29")}
+"""automan class of each section (its quick preset: the name + ``Quick``) and its figures."""
+_PAIRS = [paper_and_quick(_CTVFSolidSection, name, f"Adepu & Ramachandran (2021), {figs}", __name__, section=key)
+          for key, (name, figs) in CLASS_NAMES.items()]
+PAPER_PROBLEMS = [paper for paper, _ in _PAIRS]
+QUICK_PROBLEMS = [quick for _, quick in _PAIRS]
+globals().update({cls.__name__: cls for cls in PAPER_PROBLEMS + QUICK_PROBLEMS})   # CTVFPlate, CTVFPlateQuick, ...
 
 if __name__ == "__main__":
     root = sys.argv[1] if len(sys.argv) > 1 else "outputs"

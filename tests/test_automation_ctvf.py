@@ -84,12 +84,13 @@ def test_solid_problems_define_their_runs_and_figures(tmp_path):
         assert prob.cases and all(f"run {app} " in c.command and "--threads=1" in c.command for c in prob.cases)
         assert len({c.root for c in prob.cases}) == len(prob.cases)
         assert figs and callable(draw)
-    assert len(names) == 10 and "ctvf_figs24-28_rings_quick" in names
+    assert len(names) == 12 and "ctvf_figs24-28_rings_quick" in names
     paper = cs.PRESETS["paper"]
     assert [p["vf"] for p in cs.table1_cases(paper["table1"]).values()] == [0.001, 0.01, 0.03, 0.05]
     plate = cs.plate_cases(paper["plate"])
     assert plate["gtvf_spst"]["shifting"] == "spst" and "free_surface" in plate["gtvf_spst"]
     assert plate["ctvf_spst_h001"]["height"] == 0.01 and plate["ctvf_spst_h001"]["separation_time"] == 0.51
+    assert [p["nh"] for p in cs.fig21_cases(paper["fig21"]).values()] == [10, 20, 30]
     assert {p["shifting"] for p in cs.ring_cases(paper["rings"]).values()} == {"spst", "ipst"}
     assert set(cs.uniaxial_cases(paper["uniaxial"])) == {"ctvf_dx0.5mm", "ctvf_dx1mm", "ctvf_dx2mm", "gtvf_dx1mm"}
     # the quick preset is never finer than the paper's
