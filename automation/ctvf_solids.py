@@ -309,7 +309,7 @@ def ring_figures(sim_dir, out_dir, cfg):
                                 [(f"{label}, t = {ts * 1e3:.3g} ms", x, y, p) for ts, x, y, p in snaps],
                                 size=(8.0, 3.2), marker=1)
     overlay(os.path.join(out_dir, "fig28_points.png"), points, "t [ms]", "position [m]",
-            "Fig. 28: points A (outer left) and B (outer top) of the left ring (Gray et al.'s curve not shipped)")
+            "Fig. 28: A (outer left), B (outer top) of the left ring; Gray et al. not shipped")
     overlay(os.path.join(out_dir, "rings_energy.png"), energy, "t [ms]", "E / E(0) (kinetic + elastic + contact)",
             "colliding rings: total energy")
     overlay(os.path.join(out_dir, "rings_gap.png"), gap, "t [ms]", "gap between the rings / dx",
