@@ -1,7 +1,7 @@
 #!/usr/bin/env python
 """Regenerate every figure: ``python automate.py`` (automan; see ``--help``).
 
-``python automate.py variational`` (or ``ctvf``, ``edac``, ``superfluid``,
+``python automate.py variational`` (or ``ctvf``, ``ctvf_solids_quick``, ``edac``, ``superfluid``,
 ``superfluid_quick``, ``thermo``, ``thermo_quick``) regenerates one paper's figures;
 automan's own names work too: a problem's class name (``VariationalOrder``) or its output
 folder name (``ctvf_fig13_cavity``).  Simulations go to ``outputs/``, figures to
@@ -13,6 +13,7 @@ import sys
 from automan.api import Automator
 
 from automation.ctvf_cavity import CTVFCavityVoid
+from automation.ctvf_solids import PAPER_PROBLEMS as CTVF_SOLIDS, QUICK_PROBLEMS as CTVF_SOLIDS_QUICK
 from automation.ctvf_taylor_green import CTVFTaylorGreen
 from automation.taylor_green import TaylorGreenEDAC
 from automation.superfluid import Superfluid, SuperfluidQuick
@@ -22,7 +23,8 @@ from automation.variational import VariationalDamBreak, VariationalEjection, Var
 # one entry per paper: the group name a user types
 PAPERS = {
     "edac": [TaylorGreenEDAC],
-    "ctvf": [CTVFTaylorGreen, CTVFCavityVoid],
+    "ctvf": [CTVFTaylorGreen, CTVFCavityVoid, *CTVF_SOLIDS],
+    "ctvf_solids_quick": CTVF_SOLIDS_QUICK,
     "variational": [VariationalDamBreak, VariationalOrder, VariationalEnergy, VariationalEjection],
     "superfluid": [Superfluid],
     "superfluid_quick": [SuperfluidQuick],

@@ -44,4 +44,13 @@ class SphgenProblem(Problem):
             return json.load(f)
 
 
-__all__ = ["SphgenProblem", "SphgenTask", "Simulation"]
+def paper_and_quick(base, name, doc, module, **attrs):
+    """Two subclasses of ``base``: ``name`` (preset "paper") and ``name + "Quick"`` (preset
+    "quick"), with the class attributes ``attrs``, documented by ``doc``."""
+    paper = type(name, (base,), {**attrs, "__doc__": doc, "__module__": module})
+    quick = type(name + "Quick", (paper,), {"preset": "quick", "__doc__": doc + " (quick preset)",
+                                             "__module__": module})
+    return paper, quick
+
+
+__all__ = ["SphgenProblem", "SphgenTask", "Simulation", "paper_and_quick"]

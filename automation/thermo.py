@@ -34,7 +34,7 @@ import sys
 import numpy as np
 
 from .superfluid import _json, _plt, _save
-from .tasks import SphgenProblem, Simulation
+from .tasks import SphgenProblem, Simulation, paper_and_quick
 
 THIRD = repr(1.0 / 3.0)
 SIXTH = repr(1.0 / 6.0)
@@ -645,10 +645,7 @@ class _ThermoSection(SphgenProblem):
 
 
 def _section(name, section, doc):
-    paper = type(name, (_ThermoSection,), {"section": section, "__doc__": doc, "__module__": __name__})
-    quick = type(name + "Quick", (paper,), {"preset": "quick", "__doc__": doc + " (quick preset)",
-                                             "__module__": __name__})
-    return paper, quick
+    return paper_and_quick(_ThermoSection, name, doc, __name__, section=section)
 
 
 ThermoMMSFigures, ThermoMMSFiguresQuick = _section("ThermoMMSFigures", "mms", "Sec. 7.1: Figs. 1-3")

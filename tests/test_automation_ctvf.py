@@ -69,3 +69,54 @@ def test_cavity_void_figure_from_finished_runs(tmp_path):
     out = figure(str(sim), str(tmp_path / "fig"), nx=20)
     assert out == {"nx20": {"t": 2.0, "largest_empty_disc_over_dx": 1.7}}     # nx20_nocorr: not run
     assert os.path.getsize(tmp_path / "fig" / "fig13_cavity_void.png") > 1000
+
+
+# ------------------------------------------------------------------ automation/ctvf_solids.py
+def test_solid_problems_define_their_runs_and_figures(tmp_path):
+    """Every CTVF solid problem (both presets): distinct folders, one ``sphgen run`` per case
+    with one thread, and the figure files it promises (nothing is run)."""
+    from automation import ctvf_solids as cs
+    names = set()
+    for cls in cs.PAPER_PROBLEMS + cs.QUICK_PROBLEMS:
+        prob = cls(str(tmp_path / "outputs"), str(tmp_path / "figures"))
+        names.add(prob.get_name())
+        folder, app, cases, draw, figs = cs.SECTIONS[cls.section]
+        assert prob.cases and all(f"run {app} " in c.command and "--threads=1" in c.command for c in prob.cases)
+        assert len({c.root for c in prob.cases}) == len(prob.cases)
+        assert figs and callable(draw)
+    assert len(names) == 12 and "ctvf_figs24-28_rings_quick" in names
+    paper = cs.PRESETS["paper"]
+    assert [p["vf"] for p in cs.table1_cases(paper["table1"]).values()] == [0.001, 0.01, 0.03, 0.05]
+    plate = cs.plate_cases(paper["plate"])
+    assert plate["gtvf_spst"]["shifting"] == "spst" and "free_surface" in plate["gtvf_spst"]
+    assert plate["ctvf_spst_h001"]["height"] == 0.01 and plate["ctvf_spst_h001"]["separation_time"] == 0.51
+    assert [p["nh"] for p in cs.fig21_cases(paper["fig21"]).values()] == [10, 20, 30]
+    assert {p["shifting"] for p in cs.ring_cases(paper["rings"]).values()} == {"spst", "ipst"}
+    assert set(cs.uniaxial_cases(paper["uniaxial"])) == {"ctvf_dx0.5mm", "ctvf_dx1mm", "ctvf_dx2mm", "gtvf_dx1mm"}
+    # the quick preset is never finer than the paper's
+    assert cs.PRESETS["quick"]["rings"]["dx"] >= paper["rings"]["dx"]
+    assert min(cs.PRESETS["quick"]["uniaxial"]["dx"]) >= min(paper["uniaxial"]["dx"])
+
+
+def test_impact_quick_preset_end_to_end(tmp_path):
+    """CTVFImpactQuick: its two runs through the automan task, then its figures."""
+    import subprocess
+    from automation.ctvf_solids import PRESETS, SECTIONS, CTVFImpactQuick
+    from automation.tasks import SphgenTask
+    prob = CTVFImpactQuick(str(tmp_path / "outputs"), str(tmp_path / "figures"))
+    for case in prob.cases:
+        task = SphgenTask(case.command, case.root)
+        assert not task.complete()
+        subprocess.run(task.command, check=True, capture_output=True)
+        assert task.complete()
+    prob.run()
+    out = tmp_path / "figures" / prob.get_name()
+    for name in SECTIONS["impact"][4]:
+        assert os.path.getsize(out / name) > 100, name
+    with open(out / "summary.json") as f:
+        summary = json.load(f)
+    assert set(summary) == {"ctvf_spst", "gtvf"}
+    for r in summary.values():
+        assert r["t"] == pytest.approx(PRESETS["quick"]["impact"]["tf"]) and r["hole_width"] > 0
+    assert "| ctvf_spst |" in (out / "summary.md").read_text()
+
