@@ -6,7 +6,8 @@ rings --dx 0.0005 --one-body`` is the same two rings on the same lattice in one 
 (17 584 particles; CTVF + SPST, quintic spline at h = dx: different physics, the same kind
 of work; the default two-body run adds the contact pass); ``sphgen run beryllium_plate``
 (SHTC, Wendland C2 at h = 1.5 dr, two neighbour-list builds per step) is a solid of similar
-cost.  Each code runs ``--steps`` steps, serial and with 2 threads, interleaved,
+cost.  ``sphgen run shtc_cavity --nx 80`` (SHTC fluid, the lid-driven cavity of issue 10,
+7 360 particles with the walls) is timed beside them, without a PySPH counterpart.  Each code runs ``--steps`` steps, serial and with 2 threads, interleaved,
 ``--repeat`` times; medians of the time loop's wall time per particle-step are printed,
 with the ratio against PySPH at the same thread count.
 
@@ -25,7 +26,9 @@ from roofline import median_run_line, peak_gflops  # noqa: E402
 
 PYSPH_DT = 1e-8     # solid_mech.rings' fixed step
 CASES = {"sphgen rings": ("rings", ["--dx", "0.0005", "--one-body"]),
-         "sphgen beryllium_plate": ("beryllium_plate", [])}
+         "sphgen beryllium_plate": ("beryllium_plate", []),
+         "sphgen shtc_cavity": ("shtc_cavity", ["--nx", "80", "--cs", "10", "--dt", "2e-4"])}
+SOLIDS = ("sphgen rings", "sphgen beryllium_plate")     # compared with PySPH's rings
 
 
 def per_particle_step(rows):
@@ -85,7 +88,7 @@ def main():
     for label in CASES:
         print_thread_scaling(res, label, us, peak)
         for threads in (1, 2):
-            if ("pysph solid_mech.rings", threads) in us:
+            if label in SOLIDS and ("pysph solid_mech.rings", threads) in us:
                 print(f"PySPH rings / {label}, {threads} thread(s): "
                       f"{us[('pysph solid_mech.rings', threads)] / us[(label, threads)]:.2f}x per particle-step")
     print(f"load average after: {os.getloadavg()[0]:.2f}")
