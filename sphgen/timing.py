@@ -22,7 +22,7 @@ PARALLEL = ("pass ", "stage ", "neighbours: ")
 
 
 class Timers:
-    """Exclusive wall time and calls per label, accumulated by :meth:`wrap` ped callables."""
+    """Exclusive wall time and calls per label, accumulated by the callables :meth:`wrap` returns."""
 
     clock = staticmethod(time.perf_counter)
 
