@@ -119,31 +119,22 @@ class Solver:
         self.integrator.restarted(self.step, self.t)
         self.scene.update_nnps()
 
-    def _data_by_dtype(self):
-        """Every array's data, grouped by dtype in a fixed order (the snapshot's layout)."""
-        groups = {}
-        for pa in self.scene.arrays:
-            for v in pa.data.values():
-                groups.setdefault(v.dtype, []).append(v)
-        return groups
+    def _snapshot_arrays(self):
+        """Every array's data, in a fixed order (the snapshot's layout)."""
+        return [v for pa in self.scene.arrays for v in pa.data.values()]
 
     def _snapshot(self):
-        """Copy every array's data into one buffer per dtype (a concatenate each: the guard
-        runs every step, so this is a few numpy calls, not one per property)."""
-        groups = self._data_by_dtype()
-        layout = [(dt, [v.size for v in vs]) for dt, vs in groups.items()]
+        """Copy every array's data into one byte buffer (the guard runs every step, so the
+        backend copies it in parallel pieces, one call)."""
+        arrays = self._snapshot_arrays()
+        layout = [v.nbytes for v in arrays]
         if self._good is None or self._good[0] != layout:
-            self._good = (layout, [np.empty(sum(sizes), dtype=dt) for dt, sizes in layout])
-        for vs, buf in zip(groups.values(), self._good[1]):
-            np.concatenate([v.ravel() for v in vs], out=buf)
+            self._good = (layout, np.empty(sum(layout), dtype=np.uint8))
+        self.scene.engine.copy_arrays(arrays, self._good[1], True)
         self._good_t, self._good_step = self.t, self.step
 
     def _restore_snapshot(self):
-        for vs, buf in zip(self._data_by_dtype().values(), self._good[1]):
-            start = 0
-            for v in vs:   # copyto writes into v even where ravel() would return a copy
-                np.copyto(v, buf[start:start + v.size].reshape(v.shape))
-                start += v.size
+        self.scene.engine.copy_arrays(self._snapshot_arrays(), self._good[1], False)
         self.t, self.step = self._good_t, self._good_step
 
     def write_output(self, path=None):

@@ -64,8 +64,9 @@ class Timers:
         if hasattr(engine, "bind_neighbours"):
             engine.bind_neighbours = self.wrap(engine.bind_neighbours, "neighbours: lists")
         nnps.update = self.wrap(nnps.update, "neighbours: cells")
-        if hasattr(nnps, "_refine"):
-            nnps._refine = self.wrap(nnps._refine, "neighbours: refine")
+        for cut in ("_refine", "_cut_rows"):
+            if hasattr(nnps, cut):
+                setattr(nnps, cut, self.wrap(getattr(nnps, cut), "neighbours: refine"))
         scene.sort = self.wrap(scene.sort, "spatial sort")
         solver._check = self.wrap(solver._check, "blow-up guard")
         solver.write_output = self.wrap(solver.write_output, "output files")

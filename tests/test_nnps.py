@@ -434,6 +434,14 @@ def test_sort_rejects_a_frozen_list_of_another_particle_count():
 
 
 # ----------------------------------------------------------------- Verlet skin
+def packed(starts, ends, nbrs):
+    """The CSR lists of rows nbrs[starts[i]:ends[i]]."""
+    counts = np.asarray(ends, dtype=np.int64) - starts
+    offsets = np.concatenate([[0], np.cumsum(counts)]).astype(np.int32)
+    rows = [nbrs[a:b] for a, b in zip(starts, ends)]
+    return offsets, (np.concatenate(rows) if rows else np.zeros(0, np.int32)).astype(np.int32)
+
+
 def _drift(pa, dim, step, scale):
     """A smooth, particle-dependent motion and a slow growth of h."""
     idx = np.arange(pa.n)
@@ -466,7 +474,11 @@ def test_skin_gives_the_exact_lists_and_rebuilds_only_when_needed(dim, periodic,
         with_skin.update()
         fresh.update()
         for d, s in (("f", "f"), ("f", "w"), ("w", "f")):
+            starts, ends, nbrs, pairs = with_skin.rows(d, s)     # cut in place, with gaps
+            assert_same_lists(packed(starts, ends, nbrs), fresh.neighbours(d, s))
+            assert pairs == fresh.pair_totals()[(d, s)]
             assert_same_lists(with_skin.neighbours(d, s), fresh.neighbours(d, s))
+            assert with_skin.rows(d, s)[3] == pairs
     assert_same_lists(with_skin.neighbours("f", "w"),
                       brute_force(skinned[0], skinned[1], dim, 2.0, dom))
     assert with_skin.skin_distance > 0

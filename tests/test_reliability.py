@@ -225,3 +225,34 @@ def test_others_running_reads_the_runnable_count(tmp_path):
     f.write_text("2.10 1.20 0.30 3/345 6789\n")
     assert others_running(str(f)) is True
     assert others_running(str(tmp_path / "missing")) is True   # cannot tell: try
+
+
+@pytest.mark.parametrize("backend, nx", [("cython", "100"), ("python", "16")])
+def test_snapshot_restores_every_array_bit_for_bit(tmp_path, backend, nx):
+    """The guard's snapshot (one byte buffer, copied by the backend in parallel pieces)
+    brings back every property of every array, integers included, and the time."""
+    App = load_application("taylor_green")
+    kept = {}
+
+    class Capture(App):
+        def _solver(self, integrator, dt):
+            kept["solver"] = solver = super()._solver(integrator, dt)
+            return solver
+
+    Capture("taylor_green").run(["--nx", nx, "--max-steps", "3", "--no-progress", "--threads", "2",
+                                 "--backend", backend, "--disable-output", "-d", str(tmp_path)])
+    solver = kept["solver"]
+    solver._snapshot()
+    before = {(pa.name, k): v.copy() for pa in solver.scene.arrays for k, v in pa.data.items()}
+    t, step = solver.t, solver.step
+    for pa in solver.scene.arrays:
+        for v in pa.data.values():
+            v[...] = 7 if v.dtype.kind in "iu" else np.nan
+    solver.t, solver.step = -1.0, -1
+    solver._restore_snapshot()
+    assert (solver.t, solver.step) == (t, step)
+    for pa in solver.scene.arrays:
+        for k, v in pa.data.items():
+            np.testing.assert_array_equal(v, before[(pa.name, k)], err_msg=f"{pa.name}.{k}")
+    assert any(v.dtype.kind in "iu" for v in before.values())
+    assert max(v.nbytes for v in before.values()) > 65536 or backend == "python"   # pieces

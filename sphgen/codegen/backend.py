@@ -36,6 +36,19 @@ class Backend:
         """Run stage ``name`` of one stepper (a :class:`~sphgen.codegen.plan.StepperPlan`)."""
         raise NotImplementedError
 
+    def copy_arrays(self, arrays, out, save):
+        """The guard's snapshot: the bytes of every (C-contiguous) array of ``arrays``, one
+        after the other, into the uint8 buffer ``out`` (``save``) or back from it."""
+        start = 0
+        for v in arrays:
+            end = start + v.nbytes
+            if save:
+                out[start:end] = np.ascontiguousarray(v).reshape(-1).view(np.uint8)
+            else:
+                np.copyto(v, out[start:end].view(v.dtype).reshape(v.shape))
+            start = end
+        return start
+
     def max_speed2(self, arrays):
         """[(array, largest |u|^2, its particle index)] over arrays with velocities."""
         out = []

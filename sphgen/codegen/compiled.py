@@ -46,8 +46,11 @@ class CompiledBackend(Backend):
             return self._claim()     # binds everything, these neighbour lists included
         lists = {}
         for key, (dest, src, reference) in self.rendered.neighbour_lists.items():
-            lists[key] = (self.nnps.reference_neighbours(dest, src) if reference
-                          else self.nnps.neighbours(dest, src))
+            if reference:
+                off, nbrs = self.nnps.reference_neighbours(dest, src)
+                lists[key] = (off[:-1], off[1:], nbrs)
+            else:
+                lists[key] = self.nnps.rows(dest, src)[:3]
         self.module.bind_neighbours(lists)
 
     def run_pass(self, npass, t, dt):
@@ -57,6 +60,9 @@ class CompiledBackend(Backend):
     def run_stage(self, st, name, t, dt):
         self._claim()
         self._stages[(st.array, name)](t, dt)
+
+    def copy_arrays(self, arrays, out, save):
+        return self.module.copy_arrays(arrays, out, save)
 
     def max_speed2(self, arrays):
         self._claim()

@@ -5,6 +5,8 @@ from libc.math cimport *
 cimport numpy as cnp
 import numpy as np
 from cython.parallel cimport prange
+from libc.stdlib cimport free, malloc
+from libc.string cimport memcpy
 
 cdef extern from *:
     """
@@ -37,6 +39,7 @@ cdef double* ${arr}_${c} = NULL
 # ---------------------------------------------------------------- neighbour lists
 % for key in nbr_keys:
 cdef int* ${key}_off = NULL
+cdef int* ${key}_end = NULL
 cdef int* ${key}_idx = NULL
 % endfor
 
@@ -74,7 +77,7 @@ cdef void _pass_${p.name}(long d_idx, double t, double dt) noexcept nogil:
 % endfor
 % for src in p.sources:
     # source ${src.name}
-    for _k in range(${src.key}_off[d_idx], ${src.key}_off[d_idx + 1]):
+    for _k in range(${src.key}_off[d_idx], ${src.key}_end[d_idx]):
         s_idx = ${src.key}_idx[_k]
 % for line in src.zero_partials:
         ${line}
@@ -176,6 +179,48 @@ def max_speed2():
     return out
 
 
+def copy_arrays(list arrays, cnp.ndarray out, bint save):
+    """The guard's snapshot: the bytes of every array, one after the other, into ``out``
+    (``save``) or back from it; threaded over pieces of at most 64 KiB."""
+    cdef Py_ssize_t piece = 65536, nseg = 0, total = 0, nb, off, k
+    cdef Py_ssize_t cap = len(arrays) + out.nbytes // piece + 1
+    cdef char* base = <char*>cnp.PyArray_DATA(out)
+    cdef char* p
+    cdef char** where = <char**>malloc(cap * sizeof(char*))
+    cdef Py_ssize_t* at = <Py_ssize_t*>malloc(cap * sizeof(Py_ssize_t))
+    cdef Py_ssize_t* size = <Py_ssize_t*>malloc(cap * sizeof(Py_ssize_t))
+    if where == NULL or at == NULL or size == NULL:
+        free(where); free(at); free(size)
+        raise MemoryError("copy_arrays")
+    try:
+        for a in arrays:
+            if not (<cnp.ndarray>a).flags['C_CONTIGUOUS']:
+                raise TypeError("copy_arrays: needs C-contiguous arrays")
+            nb = (<cnp.ndarray>a).nbytes
+            if total + nb > out.nbytes:
+                raise ValueError("copy_arrays: the buffer is too small")
+            p = <char*>cnp.PyArray_DATA(<cnp.ndarray>a)
+            off = 0
+            while off < nb:
+                where[nseg] = p + off
+                at[nseg] = total + off
+                size[nseg] = min(piece, nb - off)
+                nseg += 1
+                off += piece
+            total += nb
+        with nogil:
+            for k in prange(nseg, num_threads=_nthreads, schedule='dynamic'):
+                if save:
+                    memcpy(base + at[k], where[k], size[k])
+                else:
+                    memcpy(where[k], base + at[k], size[k])
+    finally:
+        free(where)
+        free(at)
+        free(size)
+    return total
+
+
 # ---------------------------------------------------------------- binding
 cdef void* _ptr(object a, str what) except NULL:
     if not isinstance(a, cnp.ndarray) or not (<cnp.ndarray>a).flags['C_CONTIGUOUS']:
@@ -218,14 +263,16 @@ def bind_arrays(dict arrays):
 
 
 def bind_neighbours(dict lists):
-    """lists: {key: (offsets int32, indices int32)}."""
+    """lists: {key: (starts, ends, indices)}, int32: the neighbours of d_idx are
+    indices[starts[d_idx]:ends[d_idx]]."""
 % for key in nbr_keys:
-    global ${key}_off, ${key}_idx
+    global ${key}_off, ${key}_end, ${key}_idx
 % endfor
 % for key in nbr_keys:
     if '${key}' in lists:
-        o, i = lists['${key}']
+        o, e, i = lists['${key}']
         ${key}_off = <int*>_ptr(o, '${key}.off')
+        ${key}_end = <int*>_ptr(e, '${key}.end')
         ${key}_idx = <int*>_ptr(i, '${key}.idx')
 % endfor
     pass

@@ -21,8 +21,7 @@ import math
 import numpy as np
 
 from ._cell_list import (GridSpec, RowBuffers, bin_particles, build_csr, gather_points, largest_motion,
-                          refine_csr, remap_csr,
-                         scan, wrap_periodic)
+                          refine_csr, refine_rows, remap_csr, scan, wrap_periodic)
 
 __all__ = ["Domain", "NeighbourSearch", "NotFrozenError"]
 
@@ -167,6 +166,7 @@ class NeighbourSearch:
             raise ValueError(f"NeighbourSearch: skin must be >= 0, got {skin}")
         self.skin = skin
         self.skin_distance = 0.0
+        self._periodic_lengths = [domain.length[a] if domain.periodic[a] else 0.0 for a in range(self.dim)]
         self.n_updates = 0
         self.n_builds = 0
         self._built_at = None    # positions and h at the last rebuild (with a skin)
@@ -176,6 +176,8 @@ class NeighbourSearch:
         self._point_buffers = {}  # src -> the float64 (n, 4) buffer they live in
         self._by_name = dict(zip(names, arrays))
         self._cache = {}
+        self._row_cache = {}     # (dest, src) -> (starts, ends, nbrs, pairs) since the update
+        self._row_buffers = {}   # (dest, src) -> (ends, nbrs) kept across updates
         self._frozen = {}
         self._rows = {}          # (dest, src) -> RowBuffers kept across updates
         self._bins = {}
@@ -216,28 +218,30 @@ class NeighbourSearch:
         self.n_updates += 1
         if self._built_at is not None and self._within_skin():
             self._cache = {}
+            self._row_cache = {}
             self._points = {}
             return
         self._build()
 
     def _within_skin(self):
         """Wrap positions; True if no pair can have come within reach since the rebuild."""
-        dom = self.domain
+        dom, dim = self.domain, self.dim
         moved2, dh = 0.0, 0.0
-        lengths = [dom.length[a] if dom.periodic[a] else 0.0 for a in range(self.dim)]
+        lengths = self._periodic_lengths
         for pa in self.arrays:
-            ref = self._built_at[pa.name]
             if pa.n != self._sizes[pa.name]:
                 return False
             if not pa.n:
                 continue
-            coords = []
-            for a in range(self.dim):
-                x = self._checked(pa, _AXES[a])
-                if dom.periodic[a] and wrap_periodic(x, dom.lo[a], dom.length[a]) >= 0:
+            ref = self._built_at[pa.name]
+            coords = [pa.get(_AXES[a]) for a in range(dim)]
+            for a in range(dim):
+                if dom.periodic[a] and wrap_periodic(coords[a], dom.lo[a], dom.length[a]) >= 0:
                     return False              # non-finite: the rebuild names it
-                coords.append(x)
-            m2, mh = largest_motion(coords, ref[:-1], self._checked(pa, "h"), ref[-1], lengths)
+            try:
+                m2, mh = largest_motion(coords, ref[:-1], pa.get("h"), ref[-1], lengths)
+            except (TypeError, ValueError):   # replaced by a wrong array: the rebuild names it
+                return False
             if not (math.isfinite(m2) and math.isfinite(mh)):
                 return False
             moved2, dh = max(moved2, m2), max(dh, mh)
@@ -292,6 +296,7 @@ class NeighbourSearch:
                                                  self.radius_scale, skin)
             self._sizes[pa.name] = pa.n
         self._cache = {}
+        self._row_cache = {}
         self._points = {}
         self._skin_lists = {}
         self.n_builds += 1
@@ -347,17 +352,20 @@ class NeighbourSearch:
     def pair_totals(self):
         """{(dest, src): total pairs} of the lists built since the last update (cheap: one
         read per list; the blow-up guard's per-step look)."""
-        return {key: int(off[-1]) for key, (off, _) in self._cache.items() if len(off) > 1}
+        totals = {key: int(off[-1]) for key, (off, _) in self._cache.items() if len(off) > 1}
+        totals.update((key, rows[3]) for key, rows in self._row_cache.items() if len(rows[0]))
+        return totals
 
     def busiest(self):
         """(dest, src, total pairs, particle with most neighbours, its count) over the lists
         built since the last update, one tuple per (dest, src); for the blow-up guard."""
         out = []
-        for (d, s), (off, _) in self._cache.items():
-            if len(off) > 1:
-                counts = np.diff(off)
-                i = int(np.argmax(counts))
-                out.append((d, s, int(off[-1]), i, int(counts[i])))
+        counts = {key: np.diff(off) for key, (off, _) in self._cache.items() if len(off) > 1}
+        counts.update((key, rows[1] - rows[0]) for key, rows in self._row_cache.items()
+                      if key not in counts and len(rows[0]))
+        for (d, s), c in counts.items():
+            i = int(np.argmax(c))
+            out.append((d, s, int(c.sum()), i, int(c[i])))
         return out
 
     def neighbours(self, dest, src):
@@ -385,20 +393,66 @@ class NeighbourSearch:
             self._cache[key] = lists
         return lists
 
+    def rows(self, dest, src):
+        """``(starts, ends, nbrs, pairs)``: the lists of :meth:`neighbours` as rows
+        ``nbrs[starts[i]:ends[i]]`` (int32; ``pairs`` in all), for loops that take a row's
+        bounds from two arrays, as the generated passes do.  Without a skin these are views
+        of the CSR lists.  With one, the rows are cut in place from the skin lists
+        (:func:`refine_rows`): the rows hold the same neighbours in the same order, with
+        gaps between them, and cost one parallel scan instead of a scan and a compaction.
+        Cached until the next update: do not modify the returned arrays."""
+        d, s = self._array(dest), self._array(src)
+        key = (d.name, s.name)
+        rows = self._row_cache.get(key)
+        if rows is not None:
+            return rows
+        if self.skin_distance <= 0 or key in self._cache:
+            off, nbrs = self.neighbours(d, s)
+            rows = (off[:-1], off[1:], nbrs, int(off[-1]))
+        else:
+            for pa in (d, s):
+                if pa.n != self._sizes[pa.name]:
+                    raise RuntimeError(f"array '{pa.name}' has {pa.n} particles but had "
+                                       f"{self._sizes[pa.name]} at the last update(): call update()")
+            lists = self._skin_lists.get(key)
+            if lists is None:
+                lists = self._skin_lists[key] = build_csr(self.grid, self._bins[d.name], self._bins[s.name],
+                                                          buffers=self._rows.setdefault(key, RowBuffers()))
+            rows = self._cut_rows(d, s, lists)
+        self._row_cache[key] = rows
+        return rows
+
+    def _cut_rows(self, d, s, lists):
+        """The exact rows of (d, s) now, cut in place from ``lists`` (built with the skin)
+        into buffers kept across updates."""
+        key = (d.name, s.name)
+        ends, out = self._row_buffers.get(key, (None, None))
+        if ends is None or ends.size < d.n or out.size < lists[1].size:
+            ends = np.empty(max(d.n, 1), dtype=np.int32)
+            out = np.empty(int(1.25 * lists[1].size) + 16, dtype=np.int32)
+            self._row_buffers[key] = (ends, out)
+        pairs = refine_rows(self.grid, lists[0], lists[1], self._coords(d), d.get("h"),
+                            self._source_points(s), self.radius_scale, out, ends)
+        return lists[0][:-1], ends[:d.n], out, int(pairs)
+
+    def _source_points(self, s):
+        """The :func:`gather_points` records of source ``s``, gathered once per update."""
+        points = self._points.get(s.name)
+        if points is None:
+            buf = self._point_buffers.get(s.name)
+            if buf is None or buf.shape[0] < s.n:
+                buf = self._point_buffers[s.name] = np.empty((max(s.n, 1), 4), dtype=np.float64)
+            points = self._points[s.name] = gather_points(self._coords(s), s.get("h"), self.radius_scale, buf)
+        return points
+
     def _refine(self, d, s, lists):
         """The exact lists of (d, s) now, cut from ``lists`` (built with the skin)."""
         key = (d.name, s.name)
         scratch = self._scratch.get(key)
         if scratch is None or scratch.size < lists[1].size:
             scratch = self._scratch[key] = np.empty(int(1.25 * lists[1].size) + 16, dtype=np.int32)
-        points = self._points.get(s.name)
-        if points is None:    # once per update for every list with this source
-            buf = self._point_buffers.get(s.name)
-            if buf is None or buf.shape[0] < s.n:
-                buf = self._point_buffers[s.name] = np.empty((max(s.n, 1), 4), dtype=np.float64)
-            points = self._points[s.name] = gather_points(self._coords(s), s.get("h"), self.radius_scale, buf)
-        return refine_csr(self.grid, lists[0], lists[1], self._coords(d), d.get("h"), points,
-                          self.radius_scale, scratch)
+        return refine_csr(self.grid, lists[0], lists[1], self._coords(d), d.get("h"),
+                          self._source_points(s), self.radius_scale, scratch)
 
     def freeze(self, dest, src):
         """Keep the current lists of (dest, src) as the fixed reference list (Total

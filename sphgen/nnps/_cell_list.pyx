@@ -610,41 +610,63 @@ def wrap_periodic(double[::1] x, double lo, double length):
     return -1
 
 
+cdef void _motion_chunk(int dim, const double** x, const double** r, const double* L,
+                        const double* h, const double* h_ref, Py_ssize_t lo, Py_ssize_t hi,
+                        double* out) noexcept nogil:
+    """out = (largest |x - x_ref|^2, largest |h - h_ref|) over particles lo..hi-1 (NaN if
+    a value is not finite)."""
+    cdef Py_ssize_t i
+    cdef int a
+    cdef double d, d2, m2 = 0.0, mh = 0.0
+    for i in range(lo, hi):
+        d2 = 0.0
+        for a in range(dim):
+            d = x[a][i] - r[a][i]
+            if L[a] > 0.0:
+                d = d - L[a] * round(d / L[a])
+            d2 = d2 + d * d
+        d = fabs(h[i] - h_ref[i])
+        if not (isfinite(d2) and isfinite(d)):
+            m2 = d2 + d          # NaN or inf: stop
+            mh = m2
+            break
+        if d2 > m2:
+            m2 = d2
+        if d > mh:
+            mh = d
+    out[0] = m2
+    out[1] = mh
+
+
 def largest_motion(list coords, list refs, double[::1] h, double[::1] h_ref, lengths):
     """``(largest |x - x_ref|^2, largest |h - h_ref|)`` over the particles of one array;
     ``lengths[a] > 0`` makes axis ``a`` periodic (minimum image).  NaN for both as soon
-    as a value is not finite (the caller then rebuilds, which names it)."""
-    cdef Py_ssize_t i, n = h.shape[0]
+    as a value is not finite (the caller then rebuilds, which names it).  Threaded over
+    chunks of particles, each chunk's maxima reduced after."""
+    cdef Py_ssize_t n = h.shape[0], c, nchunks, size
     cdef int a, dim = len(coords)
     cdef const double* x[3]
     cdef const double* r[3]
     cdef double L[3]
-    cdef double d, d2, m2 = 0.0, mh = 0.0
+    cdef double m2 = 0.0, mh = 0.0
     if h_ref.shape[0] != n or len(refs) != dim or dim > 3:
         raise ValueError("largest_motion: the arrays do not match")
     for a in range(dim):
         x[a] = _coord_ptr(coords[a], n)
         r[a] = _coord_ptr(refs[a], n)
         L[a] = float(lengths[a])
-    with nogil:
-        for i in range(n):
-            d2 = 0.0
-            for a in range(dim):
-                d = x[a][i] - r[a][i]
-                if L[a] > 0.0:
-                    d = d - L[a] * round(d / L[a])
-                d2 = d2 + d * d
-            d = fabs(h[i] - h_ref[i])
-            if not (isfinite(d2) and isfinite(d)):
-                m2 = d2 + d          # NaN or inf: stop
-                mh = m2
-                break
-            if d2 > m2:
-                m2 = d2
-            if d > mh:
-                mh = d
-    if not (isfinite(m2) and isfinite(mh)):
-        return float("nan"), float("nan")
+    if n == 0:
+        return 0.0, 0.0
+    nchunks = min(64, (n + 1023) // 1024)
+    size = (n + nchunks - 1) // nchunks
+    cdef double[:, ::1] part = np.empty((nchunks, 2))
+    for c in prange(nchunks, nogil=True, schedule="static"):
+        _motion_chunk(dim, x, r, L, &h[0], &h_ref[0], c * size, min(n, (c + 1) * size), &part[c, 0])
+    for c in range(nchunks):
+        if not (isfinite(part[c, 0]) and isfinite(part[c, 1])):
+            return float("nan"), float("nan")
+        m2 = max(m2, part[c, 0])
+        mh = max(mh, part[c, 1])
     return m2, mh
 
 
@@ -818,80 +840,100 @@ def gather_points(list coords, double[::1] h, double radius_scale, double[:, ::1
     return out
 
 
-def refine_csr(GridSpec grid, int[::1] offsets, int[::1] nbrs, list dest_coords,
-               double[::1] dest_h, double[:, ::1] src_points, double radius_scale,
-               int[::1] scratch):
-    """The exact lists (``|r_ij| < k max(h_i, h_j)`` now) from lists with a skin.
+cdef inline Py_ssize_t _refine_row(const Grid* g, bint open_box, Py_ssize_t i, const int* nbrs,
+                                   Py_ssize_t k0, Py_ssize_t k1, const double* xd0, const double* xd1,
+                                   const double* xd2, double ri2, const double* pts,
+                                   int* out) noexcept nogil:
+    """Copy to ``out`` the candidates ``nbrs[k0:k1]`` of destination ``i`` in reach now
+    (``|r_ij|^2 < max((k h_i)^2, (k h_j)^2)``, the test of :func:`build_csr` term for
+    term); returns how many."""
+    cdef Py_ssize_t k, cnt = 0
+    cdef const double* q
+    cdef double dx, dy, dz, r2
+    cdef double xi = xd0[i]
+    cdef double yi = xd1[i] if g.dim >= 2 else 0.0
+    cdef double zi = xd2[i] if g.dim == 3 else 0.0
+    if open_box:  # no per-candidate axis tests; in 2D the z terms are 0 - 0 (pts holds 0
+        # there), and adding 0.0 leaves the build's sum unchanged
+        for k in range(k0, k1):
+            q = pts + 4 * nbrs[k]
+            dx = xi - q[0]
+            dy = yi - q[1]
+            dz = zi - q[2]
+            r2 = dx * dx + dy * dy + dz * dz
+            out[cnt] = nbrs[k]
+            cnt = cnt + (r2 < (ri2 if ri2 > q[3] else q[3]))
+        return cnt
+    for k in range(k0, k1):
+        q = pts + 4 * nbrs[k]
+        dx = xi - q[0]
+        if g.periodic[0]:
+            dx = _min_image(g, 0, dx)
+        if g.dim == 1:
+            r2 = dx * dx
+        else:
+            dy = yi - q[1]
+            if g.periodic[1]:
+                dy = _min_image(g, 1, dy)
+            if g.dim == 2:
+                r2 = dx * dx + dy * dy
+            else:
+                dz = zi - q[2]
+                if g.periodic[2]:
+                    dz = _min_image(g, 2, dz)
+                r2 = dx * dx + dy * dy + dz * dz
+        out[cnt] = nbrs[k]
+        cnt = cnt + (r2 < (ri2 if ri2 > q[3] else q[3]))
+    return cnt
+
+
+def refine_rows(GridSpec grid, int[::1] offsets, int[::1] nbrs, list dest_coords,
+                double[::1] dest_h, double[:, ::1] src_points, double radius_scale,
+                int[::1] out, int[::1] ends):
+    """The exact lists (``|r_ij| < k max(h_i, h_j)`` now) cut from lists with a skin,
+    as rows in place: row ``i`` is ``out[offsets[i]:ends[i]]``.
 
     ``offsets``/``nbrs`` hold, for every destination, a superset of its neighbours (a
     list built with a skin that still covers the motion); the coordinates and ``h`` are
     the current ones, the sources' as the records of :func:`gather_points` (gathered once
-    per update and shared by every list with that source).  Each row keeps its order;
-    the test is the one :func:`build_csr` makes, term for term, so the result equals a
-    fresh exact build.  ``scratch`` needs ``len(nbrs)`` entries.  Returns
-    ``(offsets, nbrs)``."""
+    per update and shared by every list with that source).  Each row keeps its order and
+    equals the row of a fresh exact build.  One parallel scan: no compaction, no
+    allocation (``out`` needs ``len(nbrs)`` entries, ``ends`` one per destination).
+    Returns the number of pairs."""
     cdef const Grid* g = &grid.c
-    cdef Py_ssize_t nd = dest_h.shape[0], i, k, cnt, start
+    cdef Py_ssize_t nd = dest_h.shape[0], i, cnt, total = 0
     cdef const double* xd[3]
-    cdef const double* q
-    cdef double dx, dy, dz, r2, ri2, kh
+    cdef double kh
     cdef int a
-    cdef int* tmp = _iptr(scratch)
-    cdef int[::1] counts = np.empty(nd, dtype=np.int32)
+    cdef int* po = _iptr(out)
+    cdef const int* pn = _iptr(nbrs)
     cdef const double* pts = &src_points[0, 0] if src_points.shape[0] else NULL
-    if offsets.shape[0] != nd + 1 or scratch.shape[0] < nbrs.shape[0] or src_points.shape[1] != 4:
-        raise ValueError("refine_csr: the list does not fit the arrays")
-    for a in range(g.dim):
-        xd[a] = _coord_ptr(dest_coords[a], nd)
+    if (offsets.shape[0] != nd + 1 or out.shape[0] < nbrs.shape[0] or ends.shape[0] < nd
+            or src_points.shape[1] != 4):
+        raise ValueError("refine_rows: the list does not fit the arrays")
+    for a in range(3):
+        xd[a] = _coord_ptr(dest_coords[a], nd) if a < g.dim else NULL
     cdef bint open_box = g.dim >= 2 and not (g.periodic[0] or g.periodic[1] or g.periodic[2])
-    cdef double xi, yi, zi
-    if open_box:  # the common case without the per-candidate axis tests; in 2D the z terms
-        # are 0 - 0 (pts holds 0 there), and adding 0.0 leaves the build's sum unchanged
-        for i in prange(nd, nogil=True, schedule="static"):
-            start = offsets[i]
-            cnt = 0
-            kh = radius_scale * dest_h[i]
-            ri2 = kh * kh
-            xi = xd[0][i]
-            yi = xd[1][i]
-            zi = xd[2][i] if g.dim == 3 else 0.0
-            for k in range(start, offsets[i + 1]):
-                q = pts + 4 * nbrs[k]
-                dx = xi - q[0]
-                dy = yi - q[1]
-                dz = zi - q[2]
-                r2 = dx * dx + dy * dy + dz * dz
-                tmp[start + cnt] = nbrs[k]
-                cnt = cnt + (r2 < (ri2 if ri2 > q[3] else q[3]))
-            counts[i] = <int>cnt
-        return _compact(offsets, counts, tmp, nd)
     for i in prange(nd, nogil=True, schedule="static"):
-        start = offsets[i]
-        cnt = 0
         kh = radius_scale * dest_h[i]
-        ri2 = kh * kh
-        for k in range(start, offsets[i + 1]):
-            q = pts + 4 * nbrs[k]      # (scalars, not a C array: those are shared in prange)
-            dx = xd[0][i] - q[0]
-            if g.periodic[0]:
-                dx = _min_image(g, 0, dx)
-            if g.dim == 1:
-                r2 = dx * dx
-            else:
-                dy = xd[1][i] - q[1]
-                if g.periodic[1]:
-                    dy = _min_image(g, 1, dy)
-                if g.dim == 2:
-                    r2 = dx * dx + dy * dy
-                else:
-                    dz = xd[2][i] - q[2]
-                    if g.periodic[2]:
-                        dz = _min_image(g, 2, dz)
-                    r2 = dx * dx + dy * dy + dz * dz
-            tmp[start + cnt] = nbrs[k]
-            cnt = cnt + (r2 < (ri2 if ri2 > q[3] else q[3]))
-        counts[i] = <int>cnt
-    return _compact(offsets, counts, tmp, nd)
+        cnt = _refine_row(g, open_box, i, pn, offsets[i], offsets[i + 1], xd[0], xd[1], xd[2],
+                          kh * kh, pts, po + offsets[i])
+        ends[i] = <int>(offsets[i] + cnt)
+        total += cnt
+    return total
+
+
+def refine_csr(GridSpec grid, int[::1] offsets, int[::1] nbrs, list dest_coords,
+               double[::1] dest_h, double[:, ::1] src_points, double radius_scale,
+               int[::1] scratch):
+    """The exact lists as compact CSR ``(offsets, nbrs)``: :func:`refine_rows` into
+    ``scratch`` (``len(nbrs)`` entries), then the rows packed."""
+    cdef Py_ssize_t nd = dest_h.shape[0], i
+    cdef int[::1] counts = np.empty(nd, dtype=np.int32)
+    refine_rows(grid, offsets, nbrs, dest_coords, dest_h, src_points, radius_scale, scratch, counts)
+    for i in range(nd):
+        counts[i] -= offsets[i]
+    return _compact(offsets, counts, _iptr(scratch), nd)
 
 
 cdef tuple _compact(int[::1] offsets, int[::1] counts, int* tmp, Py_ssize_t nd):
