@@ -239,3 +239,33 @@ def test_check_finite_names_the_property_and_particle():
         assert sc.check_finite() == ("fluid", prop, k // pa.props[prop].stride)
         pa.get(prop)[k] = keep
     assert sc.check_finite() is None
+
+
+def test_two_scenes_sharing_one_module_keep_their_own_neighbour_rows():
+    """Two live scenes with the same generated source share one loaded module; each takes
+    it back (arrays and neighbour rows) before running, so interleaved steps with skin
+    lists give what each scene gives alone."""
+    def scene(seed):
+        pa = lattice_cloud(nx=10, seed=seed)
+        return pa, Scene([pa], [SummationDensity("fluid", ["fluid"])], dim=2, domain=periodic_box(2),
+                         outputs={"fluid": ["rho"]}, skin=0.2)
+
+    def steps(pairs, n=6):
+        out = []
+        for k in range(n):
+            for pa, sc in pairs:
+                pa.x[:] += 0.001 * pa.u
+                pa.y[:] += 0.001 * pa.v
+                sc.update_nnps()
+                sc.compute(0, 0.0, 0.001)
+                out.append(pa.rho.copy())
+        return out
+
+    (a, sa), (b, sb) = scene(1), scene(2)
+    assert sa.engine.module is sb.engine.module
+    together = steps([(a, sa), (b, sb)])
+    alone = steps([scene(1)]), steps([scene(2)])
+    for k in range(6):
+        np.testing.assert_array_equal(together[2 * k], alone[0][k])
+        np.testing.assert_array_equal(together[2 * k + 1], alone[1][k])
+    assert sa.nnps.n_builds < sa.nnps.n_updates         # the rows were cut from kept lists

@@ -503,3 +503,15 @@ def test_skin_rebuilds_at_once_for_a_large_jump_or_a_new_particle_count():
         nn.update()
     with pytest.raises(ValueError, match="skin"):
         NeighbourSearch([pa], 2, 3.0, skin=-0.1)
+
+
+@pytest.mark.parametrize("skin", [0.0, 0.2])
+def test_neighbour_counts_without_the_lists(skin):
+    rng = np.random.default_rng(5)
+    f, w = make_array("f", 400, 2, rng, h=0.04, hvar=0.2), make_array("w", 200, 2, rng, h=0.04)
+    nn = NeighbourSearch([f, w], 2, 2.0, domain_for((True, False)), sort=False, skin=skin)
+    for d, s in (("f", "f"), ("f", "w"), ("w", "f")):
+        counts = nn.neighbour_counts(d, s)
+        assert counts.dtype == np.int32
+        np.testing.assert_array_equal(counts, np.diff(brute_force(nn._array(d), nn._array(s), 2, 2.0,
+                                                                  domain_for((True, False)))[0]))

@@ -24,6 +24,8 @@ class CompiledBackend(Backend):
         self._passes = {k: getattr(self.module, v) for k, v in self.rendered.pass_entries.items()}
         self._stages = {k: getattr(self.module, v) for k, v in self.rendered.stage_entries.items()}
         self._arrays, self._threads = None, 1
+        self._bound_lists = None      # the lists the module holds (taken again only if they change)
+        self._reference_rows = {}     # key -> row views of a frozen list
 
     def _claim(self):
         if getattr(self.module, "_sphgen_owner", None) is not self and self._arrays is not None:
@@ -36,6 +38,7 @@ class CompiledBackend(Backend):
 
     def bind(self, arrays):
         self._arrays = arrays
+        self._bound_lists = None
         self.module._sphgen_owner = self
         self.module.bind_arrays({pa.name: (pa.n, {**pa.data, **pa.constants}) for pa in arrays})
         self.module.set_parameters({g: float(getattr(o, a)) for g, (o, a) in self.rendered.parameters.items()})
@@ -48,10 +51,17 @@ class CompiledBackend(Backend):
         for key, (dest, src, reference) in self.rendered.neighbour_lists.items():
             if reference:
                 off, nbrs = self.nnps.reference_neighbours(dest, src)
-                lists[key] = (off[:-1], off[1:], nbrs)
+                rows = self._reference_rows.get(key)
+                if rows is None or rows[3] is not off or rows[2] is not nbrs:
+                    rows = self._reference_rows[key] = (off[:-1], off[1:], nbrs, off)
+                lists[key] = rows[:3]
             else:
                 lists[key] = self.nnps.rows(dest, src)[:3]
-        self.module.bind_neighbours(lists)
+        bound = self._bound_lists
+        if bound is None or bound.keys() != lists.keys() or any(
+                any(a is not b for a, b in zip(lists[k], bound[k])) for k in lists):
+            self.module.bind_neighbours(lists)    # else the module holds these very arrays
+            self._bound_lists = lists
 
     def run_pass(self, npass, t, dt):
         self._claim()

@@ -393,6 +393,15 @@ class NeighbourSearch:
             self._cache[key] = lists
         return lists
 
+    def neighbour_counts(self, dest, src):
+        """The number of neighbours of each particle of ``dest`` among ``src`` (int32), as
+        ``np.diff`` of the offsets of :meth:`neighbours` but without building the lists."""
+        d, s = self._array(dest), self._array(src)
+        lists = self._cache.get((d.name, s.name))
+        if lists is not None or self.skin_distance > 0:
+            return np.diff(self.neighbours(d, s)[0])
+        return build_csr(self.grid, self._bins[d.name], self._bins[s.name], counts_only=True)
+
     def rows(self, dest, src):
         """``(starts, ends, nbrs, pairs)``: the lists of :meth:`neighbours` as rows
         ``nbrs[starts[i]:ends[i]]`` (int32; ``pairs`` in all), for loops that take a row's
@@ -424,16 +433,18 @@ class NeighbourSearch:
 
     def _cut_rows(self, d, s, lists):
         """The exact rows of (d, s) now, cut in place from ``lists`` (built with the skin)
-        into buffers kept across updates."""
+        into buffers kept across updates (the same arrays from step to step while the skin
+        lists stand, so a backend need not take them again)."""
         key = (d.name, s.name)
-        ends, out = self._row_buffers.get(key, (None, None))
-        if ends is None or ends.size < d.n or out.size < lists[1].size:
-            ends = np.empty(max(d.n, 1), dtype=np.int32)
-            out = np.empty(int(1.25 * lists[1].size) + 16, dtype=np.int32)
-            self._row_buffers[key] = (ends, out)
+        kept = self._row_buffers.get(key)
+        if kept is None or kept[0] is not lists[0] or kept[2].size < d.n or kept[4].size < lists[1].size:
+            ends = kept[2] if kept is not None and kept[2].size >= d.n else np.empty(max(d.n, 1), np.int32)
+            out = (kept[4] if kept is not None and kept[4].size >= lists[1].size
+                   else np.empty(int(1.25 * lists[1].size) + 16, dtype=np.int32))
+            kept = self._row_buffers[key] = (lists[0], lists[0][:-1], ends, ends[:d.n], out)
         pairs = refine_rows(self.grid, lists[0], lists[1], self._coords(d), d.get("h"),
-                            self._source_points(s), self.radius_scale, out, ends)
-        return lists[0][:-1], ends[:d.n], out, int(pairs)
+                            self._source_points(s), self.radius_scale, kept[4], kept[2])
+        return kept[1], kept[3], kept[4], int(pairs)
 
     def _source_points(self, s):
         """The :func:`gather_points` records of source ``s``, gathered once per update."""

@@ -734,12 +734,14 @@ def bin_particles(GridSpec grid, list coords, double[::1] h, double radius_scale
 
 
 def build_csr(GridSpec grid, dest_bins, src_bins, Py_ssize_t block_size=128,
-              RowBuffers buffers=None):
+              RowBuffers buffers=None, bint counts_only=False):
     """CSR neighbour lists of every destination particle among the source particles.
 
     ``dest_bins``/``src_bins`` are ``bin_particles`` results on the same grid;
     ``buffers``, if given, are reused (and kept) as the blocks' scratch rows.
-    Returns ``(offsets, nbrs)``, int32, each row ascending."""
+    Returns ``(offsets, nbrs)``, int32, each row ascending; with ``counts_only`` the
+    number of neighbours of each destination (int32; the count pass alone, rows
+    unsorted)."""
     cdef int[::1] d_start, d_index, s_start, s_index
     cdef double[:, ::1] d_pts, s_pts
     d_start, d_index, d_pts = dest_bins
@@ -764,6 +766,8 @@ def build_csr(GridSpec grid, dest_bins, src_bins, Py_ssize_t block_size=128,
             reach2_s = s.pts[4 * b + 3]
         if s.index[b] != b:
             in_order = False
+    if counts_only:
+        in_order = True      # no row is kept: its order does not matter
     nb = _make_blocks(&d, ncells, block_size, bounds)
     if buffers is None:
         buffers = RowBuffers()
@@ -773,6 +777,8 @@ def build_csr(GridSpec grid, dest_bins, src_bins, Py_ssize_t block_size=128,
         failed += _block_rows(g, &d, &s, reach2_s, in_order, bounds[b], bounds[b + 1], pc, &bufs[b]) != 0
     if failed:
         raise MemoryError("out of memory while building neighbour lists")
+    if counts_only:
+        return np.asarray(counts)
     _prefix_sum(pc, nd, offsets)
     nbrs_arr = np.empty(offsets[nd], dtype=np.int32)
     nbrs = nbrs_arr

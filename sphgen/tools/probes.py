@@ -63,8 +63,7 @@ def count_neighbours(positions, radius):
     if n == 0:
         return np.zeros(0, dtype=np.int64)
     pa = ParticleArray("probe", h=np.full(n, float(radius)), **dict(zip("xyz", coords)))
-    offsets = NeighbourSearch([pa], len(coords), 1.0, sort=False).neighbours("probe", "probe")[0]
-    return np.diff(offsets).astype(np.int64)
+    return NeighbourSearch([pa], len(coords), 1.0, sort=False).neighbour_counts("probe", "probe").astype(np.int64)
 
 
 # ------------------------------------------------------------------ interpolation
