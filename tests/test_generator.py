@@ -142,3 +142,17 @@ def test_show_plan_reports_every_pass_in_order():
     assert names == [p.__name__ for p in PASSES]
     assert "    g1_fluid: au, av, omega accumulated in registers" in text
     assert "    g0_fluid <- fluid: XIJ, R2IJ, RIJ, HIJ, WIJ (~50 flops per pair)" in text
+
+
+def test_a_pass_over_other_arrays_only_is_scheduled_in_dynamic_chunks():
+    """A wall that only sees the fluid gets dynamic chunks (most wall particles may have no
+    neighbour); a pass whose destination is among its sources keeps static halves."""
+    from sphgen.codegen.render import render
+    fluid, wall = lattice_cloud("fluid", nx=6), lattice_cloud("wall", nx=6, seed=1)
+    sc = Scene([fluid, wall], [Group([SummationDensity("wall", ["fluid"])]),
+                               Group([SummationDensity("fluid", ["fluid", "wall"])])],
+               dim=2, domain=periodic_box(2), backend="python",
+               outputs={"fluid": ["rho"], "wall": ["rho"]})
+    src = render(sc.plan).source
+    loops = dict(re.findall(r"prange\((\w+)_n, num_threads=_nthreads, (schedule=[^)]*)\):\n\s+_pass", src))
+    assert loops == {"wall": "schedule='dynamic', chunksize=64", "fluid": "schedule='static'"}

@@ -55,6 +55,7 @@ class PassView:
     sources: list
     store_registers: list
     post_loop: list
+    schedule: str = "schedule='static'"   # the prange's schedule (see pass_view)
 
 
 @dataclass(frozen=True)
@@ -143,7 +144,18 @@ def pass_view(plan, p):
         [f"{r} = {m}" for r, m in pairs],
         [source_view(plan, p, loop) for loop in p.sources],
         [f"{m} = {r}" for r, m in pairs],
-        [call(ep.methods["post_loop"], p.dest) for ep in p.calls("post_loop")])
+        [call(ep.methods["post_loop"], p.dest) for ep in p.calls("post_loop")],
+        pass_schedule(p))
+
+
+def pass_schedule(p):
+    """Static halves for a pass whose destination is among its sources (every particle has
+    neighbours, about as many); dynamic chunks when it visits only other arrays (a wall
+    next to the fluid: most of its particles may have no neighbour, and static halves
+    leave one thread the work)."""
+    if not p.sources or any(loop.source == p.dest for loop in p.sources):
+        return "schedule='static'"
+    return "schedule='dynamic', chunksize=64"
 
 
 def _method_code(fp):

@@ -107,7 +107,7 @@ cdef void _pass_${p.name}(long d_idx, double t, double dt) noexcept nogil:
 def pass_${p.name}(double t, double dt):
     cdef long d_idx
     with nogil:
-        for d_idx in prange(${p.dest}_n, num_threads=_nthreads, schedule='static'):
+        for d_idx in prange(${p.dest}_n, num_threads=_nthreads, ${p.schedule}):
             _pass_${p.name}(d_idx, t, dt)
 
 % endfor
