@@ -920,8 +920,8 @@ def refine_rows(GridSpec grid, int[::1] offsets, int[::1] nbrs, list dest_coords
     for a in range(3):
         xd[a] = _coord_ptr(dest_coords[a], nd) if a < g.dim else NULL
     cdef bint open_box = g.dim >= 2 and not (g.periodic[0] or g.periodic[1] or g.periodic[2])
-    for i in prange(nd, nogil=True, schedule="static"):
-        kh = radius_scale * dest_h[i]
+    for i in prange(nd, nogil=True, schedule="dynamic", chunksize=64):  # rows of a wall list
+        kh = radius_scale * dest_h[i]                                     # vary from 0 to full
         cnt = _refine_row(g, open_box, i, pn, offsets[i], offsets[i + 1], xd[0], xd[1], xd[2],
                           kh * kh, pts, po + offsets[i])
         ends[i] = <int>(offsets[i] + cnt)
