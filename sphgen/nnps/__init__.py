@@ -177,7 +177,7 @@ class NeighbourSearch:
         self._by_name = dict(zip(names, arrays))
         self._cache = {}
         self._row_cache = {}     # (dest, src) -> (starts, ends, nbrs, pairs) since the update
-        self._row_buffers = {}   # (dest, src) -> (ends, nbrs) kept across updates
+        self._row_buffers = {}   # (dest, src) -> buffers of the cut rows, kept across updates
         self._frozen = {}
         self._rows = {}          # (dest, src) -> RowBuffers kept across updates
         self._bins = {}
@@ -379,27 +379,37 @@ class NeighbourSearch:
         key = (d.name, s.name)
         lists = self._cache.get(key)
         if lists is None:
-            for pa in (d, s):
-                if pa.n != self._sizes[pa.name]:
-                    raise RuntimeError(f"array '{pa.name}' has {pa.n} particles but had "
-                                       f"{self._sizes[pa.name]} at the last update(): call update()")
-            lists = self._skin_lists.get(key)
-            if lists is None:
-                rows = self._rows.setdefault(key, RowBuffers())
-                lists = build_csr(self.grid, self._bins[d.name], self._bins[s.name], buffers=rows)
+            lists = self._built_lists(d, s)
             if self.skin_distance > 0:
-                self._skin_lists[key] = lists
                 lists = self._refine(d, s, lists)
             self._cache[key] = lists
+        return lists
+
+    def _check_sizes(self, *arrays):
+        for pa in arrays:
+            if pa.n != self._sizes[pa.name]:
+                raise RuntimeError(f"array '{pa.name}' has {pa.n} particles but had "
+                                   f"{self._sizes[pa.name]} at the last update(): call update()")
+
+    def _built_lists(self, d, s):
+        """The lists of the cells as built (with the skin, if any; kept until the rebuild)."""
+        key = (d.name, s.name)
+        self._check_sizes(d, s)
+        lists = self._skin_lists.get(key)
+        if lists is None:
+            lists = build_csr(self.grid, self._bins[d.name], self._bins[s.name],
+                              buffers=self._rows.setdefault(key, RowBuffers()))
+            if self.skin_distance > 0:
+                self._skin_lists[key] = lists
         return lists
 
     def neighbour_counts(self, dest, src):
         """The number of neighbours of each particle of ``dest`` among ``src`` (int32), as
         ``np.diff`` of the offsets of :meth:`neighbours` but without building the lists."""
         d, s = self._array(dest), self._array(src)
-        lists = self._cache.get((d.name, s.name))
-        if lists is not None or self.skin_distance > 0:
+        if (d.name, s.name) in self._cache or self.skin_distance > 0:
             return np.diff(self.neighbours(d, s)[0])
+        self._check_sizes(d, s)
         return build_csr(self.grid, self._bins[d.name], self._bins[s.name], counts_only=True)
 
     def rows(self, dest, src):
@@ -419,15 +429,7 @@ class NeighbourSearch:
             off, nbrs = self.neighbours(d, s)
             rows = (off[:-1], off[1:], nbrs, int(off[-1]))
         else:
-            for pa in (d, s):
-                if pa.n != self._sizes[pa.name]:
-                    raise RuntimeError(f"array '{pa.name}' has {pa.n} particles but had "
-                                       f"{self._sizes[pa.name]} at the last update(): call update()")
-            lists = self._skin_lists.get(key)
-            if lists is None:
-                lists = self._skin_lists[key] = build_csr(self.grid, self._bins[d.name], self._bins[s.name],
-                                                          buffers=self._rows.setdefault(key, RowBuffers()))
-            rows = self._cut_rows(d, s, lists)
+            rows = self._cut_rows(d, s, self._built_lists(d, s))
         self._row_cache[key] = rows
         return rows
 
