@@ -175,6 +175,21 @@ def cylinder_lattice(dx, r_out, z0, z1, r_in=0.0):
     return x, y, z, V, vertex_fractions((x, y), ring, dx)
 
 
+def surface_tributary_areas(X, samples, sample_area, radius):
+    """Tributary areas of a boundary surface on the particles X (n, 3): each surface sample
+    point (m, 3), of area ``sample_area`` (scalar or (m,)), goes to the particle nearest to it
+    (within ``radius``), so a particle carries the part of the surface closest to it and the
+    areas sum to the surface's (the boundary flux A_R Q_B of Ghavamian et al. 2021, eq. 54e)."""
+    from sphgen.tools.probes import pairs_within
+    i, j, r = pairs_within(samples.T, X.T, radius)
+    order = np.lexsort((r, i))
+    first = order[np.r_[True, i[order][1:] != i[order][:-1]]]
+    if first.size != samples.shape[0]:
+        raise InputError(f"{samples.shape[0] - first.size} surface points have no particle within {radius:g}")
+    return np.bincount(j[first], weights=np.broadcast_to(sample_area, (samples.shape[0],))[i[first]],
+                       minlength=X.shape[0])
+
+
 def columns_of(columns, rows):
     h = np.array(rows, dtype=float)
     return {k: h[:, i] for i, k in enumerate(columns)}
