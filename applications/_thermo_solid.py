@@ -264,6 +264,21 @@ def relative_l2_in_time(t1, f1, t2, f2):
     return float(np.sqrt(np.trapezoid(d * d, t1[keep]) / np.trapezoid(f1[keep] ** 2, t1[keep])))
 
 
+def probe_error(history, reference_dir, prefix="probe_u"):
+    """The probe's vector curve (columns ``prefix`` x, y, z of ``history``, {column: array})
+    against a finished run's (``reference_dir``/history.json), relative L2 in time over the
+    common interval: ||f - f_ref|| / ||f_ref|| with the reference interpolated on our times."""
+    with open(os.path.join(reference_dir, "history.json")) as f:
+        h = json.load(f)
+    ref = columns_of(h["columns"], h["rows"])
+    t, tr = history["t"], ref["t"]
+    keep = t <= tr[-1] + 1e-12
+    d2 = sum((history[prefix + k][keep] - np.interp(t[keep], tr, ref[prefix + k])) ** 2 for k in "xyz")
+    r2 = sum(np.interp(t[keep], tr, ref[prefix + k]) ** 2 for k in "xyz")
+    return {"probe_error": float(np.sqrt(np.trapezoid(d2, t[keep]) / np.trapezoid(r2, t[keep]))),
+            "probe_error_interval": [0.0, float(t[keep][-1])], "reference_run": os.path.abspath(reference_dir)}
+
+
 def checkerboard(X, V, f, h, kernel="wendland"):
     """R[f] = ||f - S f||_V / ||f - mean f||_V with the Shepard average S f_a =
     sum_b V_b f_b W_ab / sum_b V_b W_ab on the reference positions X (n, 3): the spurious
