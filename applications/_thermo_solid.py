@@ -175,6 +175,21 @@ def cylinder_lattice(dx, r_out, z0, z1, r_in=0.0):
     return x, y, z, V, vertex_fractions((x, y), ring, dx)
 
 
+def surface_tributary_areas(X, samples, sample_area, radius):
+    """Tributary areas of a boundary surface on the particles X (n, 3): each surface sample
+    point (m, 3), of area ``sample_area`` (scalar or (m,)), goes to the particle nearest to it
+    (within ``radius``), so a particle carries the part of the surface closest to it and the
+    areas sum to the surface's (the boundary flux A_R Q_B of Ghavamian et al. 2021, eq. 54e)."""
+    from sphgen.tools.probes import pairs_within
+    i, j, r = pairs_within(samples.T, X.T, radius)
+    order = np.lexsort((r, i))
+    first = order[np.r_[True, i[order][1:] != i[order][:-1]]]
+    if first.size != samples.shape[0]:
+        raise InputError(f"{samples.shape[0] - first.size} surface points have no particle within {radius:g}")
+    return np.bincount(j[first], weights=np.broadcast_to(sample_area, (samples.shape[0],))[i[first]],
+                       minlength=X.shape[0])
+
+
 def columns_of(columns, rows):
     h = np.array(rows, dtype=float)
     return {k: h[:, i] for i, k in enumerate(columns)}
@@ -247,6 +262,21 @@ def relative_l2_in_time(t1, f1, t2, f2):
     keep = t1 <= t2[-1] + 1e-12
     d = f1[keep] - np.interp(t1[keep], t2, f2)
     return float(np.sqrt(np.trapezoid(d * d, t1[keep]) / np.trapezoid(f1[keep] ** 2, t1[keep])))
+
+
+def probe_error(history, reference_dir, prefix="probe_u"):
+    """The probe's vector curve (columns ``prefix`` x, y, z of ``history``, {column: array})
+    against a finished run's (``reference_dir``/history.json), relative L2 in time over the
+    common interval: ||f - f_ref|| / ||f_ref|| with the reference interpolated on our times."""
+    with open(os.path.join(reference_dir, "history.json")) as f:
+        h = json.load(f)
+    ref = columns_of(h["columns"], h["rows"])
+    t, tr = history["t"], ref["t"]
+    keep = t <= tr[-1] + 1e-12
+    d2 = sum((history[prefix + k][keep] - np.interp(t[keep], tr, ref[prefix + k])) ** 2 for k in "xyz")
+    r2 = sum(np.interp(t[keep], tr, ref[prefix + k]) ** 2 for k in "xyz")
+    return {"probe_error": float(np.sqrt(np.trapezoid(d2, t[keep]) / np.trapezoid(r2, t[keep]))),
+            "probe_error_interval": [0.0, float(t[keep][-1])], "reference_run": os.path.abspath(reference_dir)}
 
 
 def checkerboard(X, V, f, h, kernel="wendland"):

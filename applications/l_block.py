@@ -29,6 +29,8 @@ relative to max_t(K + |W_ext| + |Q_in| + |E_Dir|), the largest fall of S relativ
 S(end) - S(0) and the largest rise of B after the load relative to its fall -- and the
 final probe values.
 """
+import os
+
 import numpy as np
 
 from sphgen.errors import InputError
@@ -36,7 +38,7 @@ from sphgen.geometry import inside_rectangle, l_block, vertex_fractions
 from sphgen.particles import ParticleArray
 
 from ..equations.thermo_materials import MieGruneisen
-from ._thermo_solid import ThermoSolid, checks
+from ._thermo_solid import ThermoSolid, checks, columns_of, probe_error
 
 PAPER = dict(E_young=50.05e3, nu=0.3, rho=1000.0, Cv=1.0, alpha=2.223e-4, theta_R=293.15, k_th=10.0)
 FORCE = np.array([150.0, 300.0, 450.0])
@@ -57,12 +59,17 @@ class LBlock(ThermoSolid):
     pfreq = 500
     default_variant = "reduced"
     probe_point = PROBE
+    error_key = "probe_error"   # `sphgen precision l_block --dx ... --reference-run DIR`
 
     def add_user_options(self, group):
         group.add_argument("--dx", type=float, default=0.5,
                            help="vertex spacing; 10, 6, 3 must be multiples (default %(default)s: 1323 particles)")
         self.add_scheme_options(group, "the paper's full scheme drifts J away from det F through D_J and "
                                        "stops with J <= 0 or theta <= 0 near t = 5 s on this case (docs/thermo.md)")
+        group.add_argument("--reference-run", default=None, metavar="DIR",
+                           help="a finished l_block run (its history.json): results.json gets probe_error, "
+                                "the relative L2-in-time distance of the probe's u from that run's "
+                                "(`sphgen precision l_block`)")
         group.add_argument("--load", choices=("traction", "force"), default="traction",
                            help="F1, F2 as tractions in N/m^2 (default) or total forces in N")
         group.add_argument("--load-time", type=float, default=5.0,
@@ -83,6 +90,8 @@ class LBlock(ThermoSolid):
             raise InputError(f"--face-temperatures must be positive, got {o.face_temperatures}")
         if not (np.isfinite(o.load_time) and o.load_time > 0):
             raise InputError(f"--load-time must be positive, got {o.load_time}")
+        if o.reference_run is not None and not os.path.isfile(os.path.join(o.reference_run, "history.json")):
+            raise InputError(f"--reference-run {o.reference_run}: no history.json there")
         self.dx = dx
         self.material = MieGruneisen(**PAPER)
 
@@ -125,6 +134,12 @@ class LBlock(ThermoSolid):
         s.add_load("body", tractions)
         return s
 
+    def _signature(self, arrays):
+        """The scene's identity for restarts: --reference-run only changes the analysis."""
+        sig = super()._signature(arrays)
+        sig["options"].pop("reference_run", None)
+        return sig
+
     def case_meta(self):
         o = self.options
         return {"load": o.load, "load_time": o.load_time, "face_temperatures": list(o.face_temperatures)}
@@ -134,8 +149,10 @@ class LBlock(ThermoSolid):
         the end of the load."""
         T = self.options.load_time
         b = checks(self.history_columns, self.history, T, T)
-        r = self.write_results(outdir, checks(self.history_columns, self.history, T, 0.0),
-                               {"ballistic_rise": b["ballistic_rise"], "ballistic_drop": b["ballistic_drop"]})
+        extra = {"ballistic_rise": b["ballistic_rise"], "ballistic_drop": b["ballistic_drop"]}
+        if self.options.reference_run:
+            extra.update(probe_error(columns_of(self.history_columns, self.history), self.options.reference_run))
+        r = self.write_results(outdir, checks(self.history_columns, self.history, T, 0.0), extra)
         print(f"l_block: N={r['n_particles']} t={self.solver.t:.4g} ({self.options.variant}): |dL|/sum V|p| "
               f"{r['L_drift']:.2e}, |dA|/|A| after the load {r['A_drift']}, energy residual "
               f"{r['energy_residual']:.2e}, S fall {r['entropy_fall']}, B rise {r['ballistic_rise']} "

@@ -8,13 +8,16 @@ after (eq. 93); the rest is insulated.  The paper's sign is contradictory (its e
 rises first, its text says outflow): the default is heat *into* the disk for 0 < t < 2 s
 (``--heat out`` reverses it; ``--heat-time`` T: sin(2 pi t / T) to T, for short runs).  Mie-Gruneisen, E = 1474 Pa, nu = 0.478, rho_R = 10, k = 10,
 C_v = 10, alpha = 2.223e-4, theta_R = 308.15 K; E-form (``--form eta`` the eta-form),
-alpha_CFL = 0.3, the angular-momentum projection on; to 10 s.
+alpha_CFL = 0.25 (below the limited jumps' limit; the paper's 0.3 is ``--cfl 0.3``), the
+angular-momentum projection on; to 10 s.
 
 Lattice: the vertices of a box of spacing ``--dx`` inside the cylinder, volumes dx^3 times
 the fraction of the vertex cell inside (sampled on 2^3 sub-cells), so the lattice is
-symmetric about the axis and L(0) = 0.  The rim particles (cells cut by r = R) in the heated
-quarter share its lateral area pi R T / 2 in proportion to their volumes (half weight on the
-quarter's two edge planes), so the heat input is exactly Q_B pi R T / 2.
+symmetric about the axis and L(0) = 0.  The heated quarter's lateral area pi R T / 2 goes to
+the particles by tributary areas (``--heat-area tributary``, default: each gets the part of
+the rim nearest to it) or, as until round 8, to the rim cells (cut by r = R) in proportion to
+their volumes (``--heat-area volume``; uneven along the rim, docs/thermo.md "Round 9"); either
+way the heat input is exactly Q_B pi R T / 2.
 
 Probe X = [2, 4, 0] (the lattice point nearest).  ``results.json``: L drift over
 max sum V|p|, A drift over |A(0)| (throughout: nothing acts on the disk's momenta), the
@@ -27,7 +30,7 @@ from sphgen.errors import InputError
 from sphgen.particles import ParticleArray
 
 from ..equations.thermo_materials import MieGruneisen
-from ._thermo_solid import ThermoSolid, checks, cylinder_lattice
+from ._thermo_solid import ThermoSolid, checks, cylinder_lattice, surface_tributary_areas
 
 PAPER = dict(E_young=1474.0, nu=0.478, rho=10.0, Cv=10.0, alpha=2.223e-4, theta_R=308.15, k_th=10.0)
 OMEGA = np.array([1.0, 1.0, 1.0])
@@ -37,6 +40,26 @@ Q_PEAK, HEAT_END = 1591.5, 4.0
 def heat_flux(t, T=HEAT_END):
     """Q_B(t) / Q_peak: sin(2 pi t / T) up to T, then 0 (eq. 93 with the paper's T = 4 s)."""
     return float(np.sin(2.0 * np.pi * t / T)) if t <= T else 0.0
+
+
+def heated_area(x, y, z, V, frac, dx, R, T, how="tributary"):
+    """Each particle's share of the heated quarter of the rim, 0 <= atan2(Y, X) <= pi/2
+    (eq. 93): ``tributary``, the part of the rim surface nearest to it (midpoint samples dx/8
+    apart); ``volume``, the rim cells (cut by r = R, frac < 1) in proportion to their volumes
+    (half weight on the quarter's edge planes).  Either sums to pi R T / 2."""
+    if how == "tributary":
+        n_phi, n_z = int(np.ceil(4 * np.pi * R / dx)), int(np.ceil(8 * T / dx))
+        phi = (np.arange(n_phi) + 0.5) * (0.5 * np.pi / n_phi)
+        zs = z.min() + (np.arange(n_z) + 0.5) * (T / n_z)
+        P, Z = np.meshgrid(phi, zs, indexing="ij")
+        S = np.stack([R * np.cos(P).ravel(), R * np.sin(P).ravel(), Z.ravel()], 1)
+        return surface_tributary_areas(np.stack([x, y, z], 1), S, 0.5 * np.pi * R * T / S.shape[0], 2 * dx)
+    phi = np.arctan2(y, x)
+    tol = 1e-9
+    share = np.where((phi > tol) & (phi < 0.5 * np.pi - tol), 1.0,
+                     np.where((np.abs(phi) <= tol) | (np.abs(phi - 0.5 * np.pi) <= tol), 0.5, 0.0))
+    w = np.where(frac < 1.0, share * V, 0.0)
+    return 0.5 * np.pi * R * T * w / w.sum()
 
 
 class ThermoDisk(ThermoSolid):
@@ -55,6 +78,10 @@ class ThermoDisk(ThermoSolid):
         group.add_argument("--thickness", type=float, default=1.0, help="thickness T (default %(default)s m)")
         group.add_argument("--heat", choices=("in", "out"), default="in",
                            help="Q_B enters the disk while sin(pi t/2) > 0 (default) or leaves it")
+        group.add_argument("--heat-area", choices=("tributary", "volume"), default="tributary",
+                           help="how the rim particles share the heated area: the part of the rim nearest "
+                                "to each (default) or, as until round 8, the cells cut by r = R in "
+                                "proportion to their volumes")
         group.add_argument("--heat-time", type=float, default=HEAT_END,
                            help="end T of the heat flux sin(2 pi t / T) (default %(default)s s, the paper's)")
         self.add_scheme_options(group, "the paper's")
@@ -74,13 +101,7 @@ class ThermoDisk(ThermoSolid):
     def create_particles(self):
         o, dx = self.options, self.dx
         x, y, z, V, frac = cylinder_lattice(dx, o.radius, -0.5 * o.thickness, 0.5 * o.thickness)
-        phi = np.arctan2(y, x)
-        tol = 1e-9
-        rim = frac < 1.0
-        share = np.where((phi > tol) & (phi < 0.5 * np.pi - tol), 1.0,
-                         np.where((np.abs(phi) <= tol) | (np.abs(phi - 0.5 * np.pi) <= tol), 0.5, 0.0))
-        w = np.where(rim, share * V, 0.0)
-        area = 0.5 * np.pi * o.radius * o.thickness * w / w.sum()
+        area = heated_area(x, y, z, V, frac, dx, o.radius, o.thickness, o.heat_area)
         self.set_probe(np.stack([x, y, z], 1))
         px, py, pz = self.perturbed(x, y, z, dx)
         v0 = np.cross(OMEGA, np.stack([px, py, pz], 1))
@@ -106,7 +127,8 @@ class ThermoDisk(ThermoSolid):
 
     def case_meta(self):
         o = self.options
-        return {"radius": o.radius, "thickness": o.thickness, "heat": o.heat, "heat_time": o.heat_time}
+        return {"radius": o.radius, "thickness": o.thickness, "heat": o.heat, "heat_time": o.heat_time,
+                "heat_area": o.heat_area}
 
     def post_process(self, outdir):
         """Momenta throughout; E_tot, S and B from the end of the heating (4 s)."""

@@ -44,6 +44,21 @@ def test_short_free_flight_keeps_momenta_energy_budget_and_entropy(tmp_path):
     assert h["theta_max"][0] == 300.0 and h["theta_min"][0] == 250.0
 
 
+def test_probe_error_against_a_reference_run(tmp_path):
+    """--reference-run (what `sphgen precision l_block` measures): zero against the same run,
+    the relative L2-in-time distance of the probe's u against another (here half the step)."""
+    args = ["--dx", "1", "--tf", "0.4", "--load-time", "0.2"]
+    ref, h_ref = run(tmp_path / "ref", *args, "--cfl", "0.15")
+    r, h = run(tmp_path / "same", *args, "--cfl", "0.15", "--reference-run", str(tmp_path / "ref"))
+    assert r["probe_error"] == 0.0 and r["probe_error_interval"] == [0.0, pytest.approx(0.4)]
+    r, h = run(tmp_path / "other", *args, "--reference-run", str(tmp_path / "ref"))
+    u = np.stack([h[f"probe_u{k}"] for k in "xyz"], 1)
+    u_ref = np.stack([np.interp(h["t"], h_ref["t"], h_ref[f"probe_u{k}"]) for k in "xyz"], 1)
+    expected = np.sqrt(np.trapezoid(((u - u_ref) ** 2).sum(1), h["t"]) / np.trapezoid((u_ref ** 2).sum(1), h["t"]))
+    assert 0 < r["probe_error"] == pytest.approx(expected, rel=1e-12) and r["probe_error"] < 0.1
+    assert LBlock.error_key == "probe_error"
+
+
 @pytest.mark.slow
 def test_free_flight_on_the_1323_particle_lattice(tmp_path):
     """dx = 0.5 (1323 particles), the full scheme: the load squeezed into 1 s, then 2 s of
