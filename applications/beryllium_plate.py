@@ -12,8 +12,8 @@ lattice point), h = 1.5 dr, dt from eq. 26, tensile penalty c_p = ``--cp-factor`
 
 ``results.json``: the largest relative drift of the total energy (kinetic + bulk + shear +
 penalty, eqs. 13, 15, 19) over the run, the oscillation period of the centre point y_c(t)
-(its zero crossings) beside the plane-strain Euler-Bernoulli period, 2 pi/omega and the
-linear plane-strain continuum period (finite elements, ``finite_element_period``), and
+(its zero crossings) beside the plane-strain Euler-Bernoulli and Timoshenko periods,
+2 pi/omega and the linear plane-strain continuum period (finite elements, ``finite_element_period``), and
 the tear indicators (``void_fraction``: particles whose summation density fell below
 0.9 rho0; ``clump_fraction``: particles with a neighbour closer than dr/2; both zero for
 an elastic plate, whose strains stay below 1%).  Plots: centre.png, energy.png,
@@ -38,6 +38,7 @@ L, W = 0.06, 0.01
 RHO0, C0 = 1850.0, 9046.59
 AMP, OMEGA, ALPHA, A1, A2 = 4.3369e-5, 2.3597e5, 78.834, 56.6368, 57.6455
 HDR = 1.5
+BETA_L = 4.730040745   # first root of cos(bL) cosh(bL) = 1 (free-free beam)
 PERIOD_CONTINUUM = 2.786e-5
 """The linear plane-strain continuum period: finite_element_period at 60 x 10 and 96 x 16
 elements (2.7782e-5, 2.7830e-5 s) extrapolated as (size)^2 (docs/shtc.md)."""
@@ -64,15 +65,59 @@ def bending_velocity(x):
     return AMP * OMEGA * (A1 * (np.sinh(s) + np.sin(s)) - A2 * (np.cosh(s) + np.cos(s)))
 
 
-def euler_bernoulli_period(c0=C0, cs=C0, length=L, width=W, beta_l=4.730040745):
-    """First free-free bending period of a plane-strain Euler-Bernoulli beam of the linearised
-    SHTC material (K = rho0 c0^2, mu = rho0 cs^2; derivation in docs/shtc.md)."""
+def plane_strain_modulus(c0=C0, cs=C0):
+    """E' = E/(1 - nu^2) per unit density of the linearised SHTC material (K = rho0 c0^2,
+    mu = rho0 cs^2): the bending stiffness of a plane-strain beam (docs/shtc.md)."""
     K, mu = c0 ** 2, cs ** 2                     # per unit density
     E = 9.0 * K * mu / (3.0 * K + mu)
     nu = (3.0 * K - 2.0 * mu) / (2.0 * (3.0 * K + mu))
-    Ep = E / (1.0 - nu * nu)                     # plane strain
-    omega = beta_l ** 2 / length ** 2 * math.sqrt(Ep * width ** 2 / 12.0)
+    return E / (1.0 - nu * nu)
+
+
+def euler_bernoulli_period(c0=C0, cs=C0, length=L, width=W, beta_l=BETA_L):
+    """First free-free bending period of a plane-strain Euler-Bernoulli beam of the linearised
+    SHTC material (K = rho0 c0^2, mu = rho0 cs^2; derivation in docs/shtc.md)."""
+    omega = beta_l ** 2 / length ** 2 * math.sqrt(plane_strain_modulus(c0, cs) * width ** 2 / 12.0)
     return 2.0 * math.pi / omega
+
+
+def timoshenko_period(c0=C0, cs=C0, length=L, width=W, kappa=5.0 / 6.0):
+    """First free-free bending period of a plane-strain Timoshenko beam (Timoshenko 1921: shear
+    deformation with coefficient kappa and rotary inertia) of the linearised SHTC material: the
+    lowest root of the symmetric-mode frequency equation derived in docs/shtc.md,
+    P_a a^2 cosh(aL/2) sin(bL/2) + Q_b b^2 cos(bL/2) sinh(aL/2) = 0, found by bisection."""
+    Ep, kg = plane_strain_modulus(c0, cs), kappa * cs ** 2     # E', kappa mu per unit density
+    r2 = width ** 2 / 12.0                                     # I/A of the rectangular section
+
+    def frequency_function(omega):
+        w2 = omega * omega
+        p = w2 * (1.0 / Ep + 1.0 / kg)
+        q = w2 / (Ep * r2) * (1.0 - w2 * r2 / kg)            # > 0 below the shear cut-off
+        s = math.sqrt(p * p + 4.0 * q)
+        a, b = math.sqrt(0.5 * (s - p)), math.sqrt(0.5 * (s + p))
+        pa, qb = a + w2 / (kg * a), b - w2 / (kg * b)          # phi/w amplitude ratios
+        return (pa * a * a * math.cosh(0.5 * a * length) * math.sin(0.5 * b * length)
+                + qb * b * b * math.cos(0.5 * b * length) * math.sinh(0.5 * a * length))
+
+    omega_eb = 2.0 * math.pi / euler_bernoulli_period(c0, cs, length, width)
+    lo, hi = 0.2 * omega_eb, 0.2 * omega_eb                    # shear and rotary inertia lower omega
+    f_lo = frequency_function(lo)
+    while True:                                                # first sign change above 0.2 omega_EB
+        hi = lo + 0.0025 * omega_eb
+        if hi > 1.2 * omega_eb:
+            raise ValueError("no Timoshenko root below 1.2 omega_EB")
+        f_hi = frequency_function(hi)
+        if f_lo * f_hi <= 0.0:
+            break
+        lo, f_lo = hi, f_hi
+    for _ in range(100):
+        mid = 0.5 * (lo + hi)
+        f_mid = frequency_function(mid)
+        if f_lo * f_mid <= 0.0:
+            hi = mid
+        else:
+            lo, f_lo = mid, f_mid
+    return 4.0 * math.pi / (lo + hi)
 
 
 def finite_element_period(nx, ny, c0=C0, cs=C0, length=L, width=W):
@@ -224,7 +269,7 @@ class BerylliumPlate(Application):
         dr = hist["dr"]
         void, clump = tear_indicators(state["x"], state["y"], state["rho"], dr, hist["rho0"])
         period, how = measured_period(t, yc)
-        t_eb, t_omega = euler_bernoulli_period(), 2 * math.pi / OMEGA
+        t_eb, t_omega, t_timo = euler_bernoulli_period(), 2 * math.pi / OMEGA, timoshenko_period()
         results = {
             "t": float(t[-1]), "nw": hist["nw"], "cp_factor": hist["cp_factor"], "dr": dr,
             "energy_drift": float(drift.max()), "energy_drift_final": float(drift[-1]),
@@ -236,6 +281,8 @@ class BerylliumPlate(Application):
             "period_euler_bernoulli": t_eb, "period_initial_omega": t_omega,
             "period_error_euler_bernoulli": None if period is None else period / t_eb - 1.0,
             "period_error_initial_omega": None if period is None else period / t_omega - 1.0,
+            "period_timoshenko": t_timo,
+            "period_error_timoshenko": None if period is None else period / t_timo - 1.0,
             "period_continuum": PERIOD_CONTINUUM,
             "period_error_continuum": None if period is None else period / PERIOD_CONTINUUM - 1.0,
             "centre_max": float(yc.max()), "t_centre_max": float(t[np.argmax(yc)]),
@@ -246,7 +293,7 @@ class BerylliumPlate(Application):
         self.plot(outdir, t, yc, rows[:, 2:], state, hist)
         p = "n/a" if period is None else f"{period:.4g} s ({how})"
         print(f"beryllium_plate: t={t[-1]:.4g}  energy drift {results['energy_drift']:.3g}  period {p} "
-              f"(Euler-Bernoulli {t_eb:.4g}, 2pi/omega {t_omega:.4g}, continuum {PERIOD_CONTINUUM:.4g})  void {void:.3g}  clump {clump:.3g}\n"
+              f"(Euler-Bernoulli {t_eb:.4g}, Timoshenko {t_timo:.4g}, 2pi/omega {t_omega:.4g}, continuum {PERIOD_CONTINUUM:.4g})  void {void:.3g}  clump {clump:.3g}\n"
               f"results: {os.path.join(outdir, 'results.json')}")
         return results
 
