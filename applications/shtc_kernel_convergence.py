@@ -100,6 +100,8 @@ class SHTCKernelConvergence(Application):
                            help="kernels (default %(default)s)")
 
     def consume_user_options(self, o):
+        if not all(math.isfinite(h) and h > 0 for h in o.h):
+            raise InputError(f"--h must be positive, got {o.h}")
         if len(o.h) < 2 or len(set(o.h)) < 2:
             raise InputError("--h needs at least two different smoothing lengths for a slope")
         for name in o.kernel:
