@@ -69,8 +69,12 @@ class SHTCShearWave(Application):
         x, y = np.mgrid[dr / 2:1:dr, dr / 2:1:dr]
         x, y = x.ravel(), y.ravel()
         n = x.size
-        return [ParticleArray("fluid", x=x, y=y, u=U0 * np.sin(K * y), v=np.zeros(n), m=np.full(n, RHO0 * dr * dr),
+        return [ParticleArray("fluid", x=x, y=y, u=self.initial_velocity(y), v=np.zeros(n), m=np.full(n, RHO0 * dr * dr),
                               h=np.full(n, HDR * dr), rho=np.full(n, RHO0))]
+
+    def initial_velocity(self, y):
+        """u(y) at t = 0: the wave U sin(k y)."""
+        return U0 * np.sin(K * y)
 
     def create_domain(self):
         return Domain(0.0, 1.0, 0.0, 1.0, periodic_in_x=True, periodic_in_y=True)
