@@ -133,7 +133,8 @@ def count_nonfinite():
 % for arr, props in guarded:
 % for stride in sorted(set(st for _, st in props)):
     with nogil:
-        for i in prange(${arr}_n * ${stride}, num_threads=_nthreads, schedule='static'):
+        for i in prange(${arr}_n * ${stride}, num_threads=_nthreads if ${arr}_n * ${stride} > 16384 else 1,
+                        schedule='static'):
             bad += ${" + ".join(f"(not isfinite({arr}_{p}[i]))" for p, st in props if st == stride)}
 % endfor
 % endfor
@@ -208,8 +209,8 @@ def copy_arrays(list arrays, cnp.ndarray out, bint save):
                 nseg += 1
                 off += piece
             total += nb
-        with nogil:
-            for k in prange(nseg, num_threads=_nthreads, schedule='dynamic'):
+        with nogil:  # below 1 MiB one thread copies faster than two start and join
+            for k in prange(nseg, num_threads=_nthreads if total > 1048576 else 1, schedule='dynamic'):
                 if save:
                     memcpy(base + at[k], where[k], size[k])
                 else:
