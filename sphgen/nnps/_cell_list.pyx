@@ -645,8 +645,8 @@ cdef void _motion_chunk(int dim, const double** x, const double** r, const doubl
 def largest_motion(list coords, list refs, double[::1] h, double[::1] h_ref, lengths):
     """``(largest |x - x_ref|^2, largest |h - h_ref|)`` over the particles of one array;
     ``lengths[a] > 0`` makes axis ``a`` periodic (minimum image).  NaN for both as soon
-    as a value is not finite (the caller then rebuilds, which names it).  Threaded over
-    chunks of particles, each chunk's maxima reduced after."""
+    as a value is not finite (the caller then rebuilds, which names it).  From
+    ``_SERIAL_BELOW`` particles on, threaded over chunks, each chunk's maxima reduced after."""
     cdef Py_ssize_t n = h.shape[0], c, nchunks, size
     cdef int a, dim = len(coords)
     cdef const double* x[3]
