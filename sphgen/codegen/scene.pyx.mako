@@ -133,7 +133,7 @@ def count_nonfinite():
 % for arr, props in guarded:
 % for stride in sorted(set(st for _, st in props)):
     with nogil:
-        for i in prange(${arr}_n * ${stride}, num_threads=_nthreads if ${arr}_n * ${stride} > 16384 else 1,
+        for i in prange(${arr}_n * ${stride}, num_threads=_nthreads if ${arr}_n * ${stride} > ${serial_below} else 1,
                         schedule='static'):
             bad += ${" + ".join(f"(not isfinite({arr}_{p}[i]))" for p, st in props if st == stride)}
 % endfor

@@ -51,6 +51,7 @@ cdef Py_ssize_t _SHORT_ROW = 48
 # region's start and join (a few microseconds) cost more than the loop (dam break,
 # 3 384 particles: gathering the source records took 3.4 us serially, 4.8 us on 2 threads)
 cdef Py_ssize_t _SERIAL_BELOW = 16384
+SERIAL_BELOW = _SERIAL_BELOW     # the generated modules' small loops follow the same rule
 
 
 ctypedef struct Grid:
