@@ -515,3 +515,27 @@ def test_neighbour_counts_without_the_lists(skin):
         assert counts.dtype == np.int32
         np.testing.assert_array_equal(counts, np.diff(brute_force(nn._array(d), nn._array(s), 2, 2.0,
                                                                   domain_for((True, False)))[0]))
+
+
+@pytest.mark.parametrize("dim", [1, 2, 3])
+def test_largest_motion_matches_numpy_in_every_lane_and_catches_non_finite(dim):
+    """The skin check's reduction (four lanes and a remainder in an open box) equals the
+    plain maxima, wherever the largest motion sits, and is NaN for a non-finite value."""
+    from sphgen.nnps._cell_list import largest_motion
+    rng = np.random.default_rng(dim)
+    for n in (1, 3, 4, 5, 11, 64):
+        for lane in range(n):
+            ref = [rng.random(n) for _ in range(dim)]
+            x = [r + 1e-3 * rng.standard_normal(n) for r in ref]
+            x[-1][lane] += 0.5                          # the largest motion, in this lane
+            h_ref = rng.random(n) + 1.0
+            h = h_ref.copy()
+            h[(lane + 1) % n] += 0.25
+            m2, mh = largest_motion(x, ref, h, h_ref, [0.0] * dim)
+            assert m2 == max(sum((a - b) ** 2 for a, b in zip(x, ref)))
+            assert mh == np.abs(h - h_ref).max()
+            periodic = largest_motion(x, ref, h, h_ref, [100.0] * dim)
+            assert periodic[0] == pytest.approx(m2, rel=1e-12) and periodic[1] == mh
+        for bad in (np.nan, np.inf):
+            x[0][n - 1] = bad
+            assert all(np.isnan(v) for v in largest_motion(x, ref, h, h_ref, [0.0] * dim))

@@ -615,6 +615,52 @@ def wrap_periodic(double[::1] x, double lo, double length):
     return -1
 
 
+cdef void _open_motion_chunk(int dim, const double** x, const double** r, const double* h,
+                             const double* h_ref, Py_ssize_t lo, Py_ssize_t hi,
+                             double* out) noexcept nogil:
+    """:func:`_motion_chunk` without periodic axes, branch-free: four particles per turn
+    into four independent maxima (the loop is bound by its dependency chains otherwise);
+    a non-finite value is caught once at the end through a running sum, which NaN and
+    inf propagate (an overflow of that sum only makes the caller rebuild, which is
+    always safe)."""
+    cdef Py_ssize_t i, k
+    cdef int a
+    cdef double m[4]
+    cdef double mh[4]
+    cdef double d, d2, e, bad = 0.0
+    for k in range(4):
+        m[k] = 0.0
+        mh[k] = 0.0
+    i = lo
+    while i + 4 <= hi:
+        for k in range(4):
+            d2 = 0.0
+            for a in range(dim):
+                d = x[a][i + k] - r[a][i + k]
+                d2 = d2 + d * d
+            e = fabs(h[i + k] - h_ref[i + k])
+            bad = bad + (d2 + e)
+            m[k] = d2 if d2 > m[k] else m[k]
+            mh[k] = e if e > mh[k] else mh[k]
+        i = i + 4
+    while i < hi:
+        d2 = 0.0
+        for a in range(dim):
+            d = x[a][i] - r[a][i]
+            d2 = d2 + d * d
+        e = fabs(h[i] - h_ref[i])
+        bad = bad + (d2 + e)
+        m[0] = d2 if d2 > m[0] else m[0]
+        mh[0] = e if e > mh[0] else mh[0]
+        i = i + 1
+    if not isfinite(bad):
+        out[0] = bad - bad   # NaN
+        out[1] = out[0]
+        return
+    out[0] = max(max(m[0], m[1]), max(m[2], m[3]))
+    out[1] = max(max(mh[0], mh[1]), max(mh[2], mh[3]))
+
+
 cdef void _motion_chunk(int dim, const double** x, const double** r, const double* L,
                         const double* h, const double* h_ref, Py_ssize_t lo, Py_ssize_t hi,
                         double* out) noexcept nogil:
@@ -623,6 +669,9 @@ cdef void _motion_chunk(int dim, const double** x, const double** r, const doubl
     cdef Py_ssize_t i
     cdef int a
     cdef double d, d2, m2 = 0.0, mh = 0.0
+    if not (L[0] > 0.0 or (dim > 1 and L[1] > 0.0) or (dim > 2 and L[2] > 0.0)):
+        _open_motion_chunk(dim, x, r, h, h_ref, lo, hi, out)
+        return
     for i in range(lo, hi):
         d2 = 0.0
         for a in range(dim):
@@ -869,10 +918,12 @@ cdef inline Py_ssize_t _refine_row(const Grid* g, bint open_box, Py_ssize_t i, c
     term); returns how many."""
     cdef Py_ssize_t k, cnt = 0
     cdef const double* q
-    cdef double dx, dy, dz, r2
-    cdef double xi = xd0[i]
-    cdef double yi = xd1[i] if g.dim >= 2 else 0.0
-    cdef double zi = xd2[i] if g.dim == 3 else 0.0
+    cdef double dx, dy, dz, r2, xi, yi, zi
+    if k1 <= k0:      # most rows of a wall list are empty: no loads for them
+        return 0
+    xi = xd0[i]
+    yi = xd1[i] if g.dim >= 2 else 0.0
+    zi = xd2[i] if g.dim == 3 else 0.0
     if open_box:  # no per-candidate axis tests; in 2D the z terms are 0 - 0 (pts holds 0
         # there), and adding 0.0 leaves the build's sum unchanged
         for k in range(k0, k1):
