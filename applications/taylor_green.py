@@ -100,6 +100,9 @@ class TaylorGreen(Application):
                            help="ipst: iteration cap (default %(default)s)")
         group.add_argument("--ipst-tolerance", type=float, default=0.02,
                            help="ipst: |max chi - chi_ref| tolerance (default %(default)s)")
+        group.add_argument("--mach", type=float, default=None,
+                           help="spst: the coefficient Ma of Sun et al.'s shifting (Adepu & Ramachandran "
+                           "2021, eq. 35; default U/c0)")
         group.add_argument("--c0", type=float, default=10.0, help="artificial sound speed (default 10 U)")
         group.add_argument("--perturb", type=float, default=DEFAULT_PERTURB,
                            help="random lattice perturbation in units of dx (default "
@@ -116,6 +119,8 @@ class TaylorGreen(Application):
     def consume_user_options(self, o):
         if o.nx < 4:
             raise InputError(f"--nx must be at least 4, got {o.nx}")
+        if o.mach is not None and not (np.isfinite(o.mach) and o.mach > 0):
+            raise InputError(f"--mach must be a positive finite number, got {o.mach}")
         for name in ("re", "hdx", "c0"):
             v = getattr(o, name)
             if not (np.isfinite(v) and v > 0):
@@ -156,7 +161,7 @@ class TaylorGreen(Application):
 
     def create_scheme(self):
         o = self.options
-        common = dict(dim=2, rho0=1.0, c0=o.c0, nu=self.nu, h=self.h, dx=self.dx, umax=1.0)
+        common = dict(dim=2, rho0=1.0, c0=o.c0, nu=self.nu, h=self.h, dx=self.dx, umax=1.0, mach=o.mach)
         ipst = dict(ipst_interval=o.ipst_interval, ipst_max_iterations=o.ipst_max_iterations,
                     ipst_tolerance=o.ipst_tolerance)
         if o.scheme == "edac":

@@ -1,14 +1,17 @@
 #!/usr/bin/env python
-"""Taylor-Green (EDAC, nx=50, Re=100, tf=0.5): sphgen against PySPH in the same run.
+"""Taylor-Green (nx=50, Re=100, tf=0.5): sphgen against PySPH in the same run.
 
 Prints, as medians of ``--repeat`` runs: time per particle-step (serial and 2 threads),
 neighbour pairs per second, the 1 -> 2 thread speed-up, the first-run compile time, and
-the ratio against PySPH 1.0b2 (``pysph run taylor_green --scheme edac``) when a PySPH
-venv is found (``PYSPH_PYTHON``; see ``pysph_baseline.find_pysph_python``).  The
-machine may be shared: each row also reports the CPU seconds other processes used
-during the runs (0 means a clean timing).
+the ratio against PySPH 1.0b2's closest case when a PySPH venv is found
+(``PYSPH_PYTHON``; see ``pysph_baseline.find_pysph_python``).  ``--scheme`` picks
+sphgen's scheme and, from :data:`PYSPH_CLOSEST`, PySPH's: EDAC against
+``pysph run taylor_green --scheme edac``; CTVF and GTVF against ``--scheme gtvf``
+(PySPH 1.0b2 has no CTVF; its GTVF has the same two evaluations per kick-drift-kick
+step, docs/performance.md).  The machine may be shared: each row also reports the CPU
+seconds other processes used during the runs (0 means a clean timing).
 
-    python benchmarks/bench_taylor_green.py [--nx 50] [--tf 0.5] [--repeat 3]
+    python benchmarks/bench_taylor_green.py [--scheme edac|ctvf|gtvf] [--nx 50] [--tf 0.5] [--repeat 3]
 """
 import argparse
 import json
@@ -23,13 +26,16 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from pysph_baseline import _busy_cpu_seconds, find_pysph_python, run_pysph  # noqa: E402
 from roofline import peak_gflops, roofline_line  # noqa: E402
 
+# sphgen's scheme -> PySPH 1.0b2's closest Taylor-Green scheme (docs/performance.md)
+PYSPH_CLOSEST = {"edac": "edac", "ctvf": "gtvf", "gtvf": "gtvf"}
 
-def run_sphgen(nx, tf, threads, workdir, cache=None):
+
+def run_sphgen(nx, tf, threads, workdir, cache=None, scheme="edac"):
     """One sphgen run as a subprocess; returns its info.json plus contention."""
-    out = os.path.join(workdir, f"sphgen_nx{nx}_t{threads}_{time.time_ns()}")
+    out = os.path.join(workdir, f"sphgen_{scheme}_nx{nx}_t{threads}_{time.time_ns()}")
     exe = os.path.join(os.path.dirname(sys.executable), "sphgen")
     # the plain lattice, as PySPH's case starts (sphgen's default start is perturbed)
-    cmd = [exe, "run", "taylor_green", "--nx", str(nx), "--tf", str(tf), "--perturb", "0", "--disable-output",
+    cmd = [exe, "run", "taylor_green", "--scheme", scheme, "--nx", str(nx), "--tf", str(tf), "--perturb", "0", "--disable-output",
            "--no-progress", "-d", out]
     cmd += ["--no-openmp"] if threads == 1 else ["--threads", str(threads)]
     env = dict(os.environ)
@@ -62,6 +68,9 @@ def summarise_sphgen(runs):
 
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--scheme", choices=sorted(PYSPH_CLOSEST), default="edac",
+                   help="sphgen's scheme (default %(default)s); PySPH runs its closest: %(choices)s -> "
+                        + ", ".join(f"{k}: {v}" for k, v in sorted(PYSPH_CLOSEST.items())))
     p.add_argument("--nx", type=int, default=50)
     p.add_argument("--tf", type=float, default=0.5)
     p.add_argument("--repeat", type=int, default=3)
@@ -69,9 +78,11 @@ def main(argv=None):
     p.add_argument("--json", default=None, help="write the results here")
     o = p.parse_args(argv)
     work = tempfile.mkdtemp(prefix="sphgen_bench_")
-    res = {"nx": o.nx, "tf": o.tf, "repeat": o.repeat, "load_start": os.getloadavg()[0]}
+    pysph_scheme = PYSPH_CLOSEST[o.scheme]
+    res = {"scheme": o.scheme, "pysph_scheme": pysph_scheme, "nx": o.nx, "tf": o.tf, "repeat": o.repeat,
+           "load_start": os.getloadavg()[0]}
 
-    cold = run_sphgen(o.nx, o.tf, 2, work, cache=os.path.join(work, "cache"))
+    cold = run_sphgen(o.nx, o.tf, 2, work, cache=os.path.join(work, "cache"), scheme=o.scheme)
     res["sphgen_compile_s"] = cold["compile_time"]
     py = None if o.no_pysph else find_pysph_python()
     # interleave the codes so a drift in machine speed hits both alike
@@ -79,10 +90,10 @@ def main(argv=None):
     theirs = {1: [], 2: []}
     for _ in range(o.repeat):
         for threads in (1, 2):
-            ours[threads].append(run_sphgen(o.nx, o.tf, threads, work))
+            ours[threads].append(run_sphgen(o.nx, o.tf, threads, work, scheme=o.scheme))
             if py:
                 theirs[threads].append(run_pysph(py, nx=o.nx, tf=o.tf, openmp=threads > 1,
-                                                 threads=threads if threads > 1 else None,
+                                                 threads=threads if threads > 1 else None, scheme=pysph_scheme,
                                                  workdir=os.path.join(work, f"pysph_{threads}")))
     for threads in (1, 2):
         res[f"sphgen_{threads}"] = summarise_sphgen(ours[threads])
@@ -103,7 +114,8 @@ def main(argv=None):
     res["roofline"] = [roofline_line(sorted(ours[t], key=lambda r: r["wall_time"])[len(ours[t]) // 2], peak,
                                      f"sphgen {t} thread(s)") for t in (1, 2)]
 
-    print(f"Taylor-Green EDAC nx={o.nx} ({o.nx * o.nx} particles), tf={o.tf}, medians of {o.repeat}")
+    print(f"Taylor-Green sphgen {o.scheme.upper()} against PySPH {pysph_scheme.upper()}, nx={o.nx} "
+          f"({o.nx * o.nx} particles), tf={o.tf}, medians of {o.repeat}")
     print(f"{'':24s}{'us/particle-step':>18s}{'pairs/s':>12s}{'wall s':>9s}  other-CPU s")
     for t in (1, 2):
         s = res[f"sphgen_{t}"]
@@ -114,10 +126,15 @@ def main(argv=None):
         if s and "us_per_particle_step" in s:
             print(f"PySPH  {t} thread(s){'':6s}{s['us_per_particle_step']:18.3f}{'':12s}{s['run_s']:9.2f}"
                   f"  {s['other_cpu_s']}")
+    counts = {res[f"pysph_{t}"]["n_real"] for t in (1, 2) if "n_real" in res.get(f"pysph_{t}", {})}
+    if counts:
+        print(f"particles: sphgen {s1['n']}, PySPH {', '.join(map(str, sorted(counts)))}"
+              + ("" if counts == {s1["n"]} else "  (NOT the same count: the ratio is not comparable)"))
     print(f"sphgen speed-up 1 -> 2 threads: {res['sphgen_speedup_1_to_2']:.2f}x")
     for t in (1, 2):
         if f"ratio_{t}" in res:
-            print(f"PySPH / sphgen time per particle-step, {t} thread(s): {res[f'ratio_{t}']:.2f}x")
+            print(f"PySPH {pysph_scheme.upper()} / sphgen {o.scheme.upper()} time per particle-step, "
+                  f"{t} thread(s): {res[f'ratio_{t}']:.2f}x")
     print(f"sphgen first-run compile time: {res['sphgen_compile_s']:.2f} s")
     for line in res["roofline"]:
         print(line)

@@ -491,3 +491,21 @@ def test_step_without_shifting_sets_the_transport_velocity_to_u():
         assert np.allclose(b["u"], a["u"] + 0.5 * dt * a["au"]) and np.allclose(b["v"], a["v"] + 0.5 * dt * a["av"])
         extra = 0.5 * dt * 7.0 if shift else 0.0
         assert np.allclose(b["uhat"], b["u"] + extra) and np.allclose(b["vhat"], b["v"] + extra)
+
+
+def test_taylor_green_mach_option_sets_the_spst_coefficient():
+    """``--mach`` is Ma of eq. 35 (default U/c0 = 0.1) for every scheme; non-positive values are refused."""
+    from sphgen.errors import InputError
+
+    def scheme(*argv):
+        app = load_application("taylor_green")()
+        app.options = app.parser().parse_args(list(argv))
+        app.consume_user_options(app.options)
+        return app.create_scheme()
+
+    assert scheme("--scheme", "ctvf").shift.mach == pytest.approx(0.1)
+    assert scheme("--scheme", "ctvf", "--mach", "0.2").shift.mach == pytest.approx(0.2)
+    assert scheme("--scheme", "gtvf", "--shifting", "spst", "--mach", "0.2").shift.mach == pytest.approx(0.2)
+    assert scheme("--scheme", "edac", "--mach", "0.2").mach == pytest.approx(0.2)
+    with pytest.raises(InputError):
+        scheme("--scheme", "ctvf", "--mach", "0")
