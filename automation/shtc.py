@@ -290,10 +290,11 @@ def plate_figures(sim_dir, out_dir, cfg):
 def _pressure(fig, ax, pa, title):
     x, y, p = _prop(pa, "x"), _prop(pa, "y"), _prop(pa, "p")
     size = float(np.clip(8000.0 / max(pa.n, 1), 0.5, 20.0))
-    sc = ax.scatter(x, y, c=p, s=size, cmap="coolwarm")
+    lo, hi = np.percentile(p, [1, 99])          # a few clumped particles do not set the scale
+    sc = ax.scatter(x, y, c=p, s=size, cmap="coolwarm", vmin=lo, vmax=hi)
     ax.set_aspect("equal")
     ax.set_title(title, fontsize=8)
-    fig.colorbar(sc, ax=ax, label="p [Pa]", shrink=0.8)
+    fig.colorbar(sc, ax=ax, label="p [Pa] (1-99 %)", shrink=0.8)
 
 
 # ------------------------------------------------------------------ column
@@ -308,11 +309,13 @@ def column_figures(sim_dir, out_dir, cfg):
             continue
         pa = shots[t][0]["column"]
         size = float(np.clip(3000.0 / max(pa.n, 1), 0.3, 10.0))
-        sc = ax.scatter(_prop(pa, "x"), _prop(pa, "z"), c=_prop(pa, "p"), s=size, cmap="coolwarm")
+        p = _prop(pa, "p")
+        lo, hi = np.percentile(p, [1, 99])
+        sc = ax.scatter(_prop(pa, "x"), _prop(pa, "z"), c=p, s=size, cmap="coolwarm", vmin=lo, vmax=hi)
         ax.set_aspect("equal")
         ax.set_title(f"t = {shots[t][1]:.3g} s", fontsize=8)
         fig.colorbar(sc, ax=ax, shrink=0.6)
-    fig.suptitle("[P] Fig. 5: twisting column, pressure [Pa], side view (x, z)", fontsize=9)
+    fig.suptitle("[P] Fig. 5: twisting column, pressure [Pa] (1-99 % range), side view (x, z)", fontsize=9)
     _save(fig, out_dir, "P_fig5")
     h = history(run)
     fig, ax = plt.subplots(figsize=(6, 3.6))
