@@ -372,3 +372,34 @@ class DamBreak2D(Application):
         fig.tight_layout()
         fig.savefig(os.path.join(outdir, "energy.png"), dpi=100)
         plt.close(fig)
+
+
+def thesis_figure_1_3(outdir, path=None):
+    """Kincl's thesis (2023), Fig. 1.3 from a finished ``dam_break_2d`` run in ``outdir``: the
+    toe X = x_wave/a against T = t sqrt(2g/a) (the thesis prints t/sqrt(2ga)) of the run ("SYM"
+    for ``--scheme symplectic``), Violeau's (2012) curve ("VIO") and Koshizuka & Oka's (1996)
+    experiment ("EXP"), both as Kincl digitised them.  Writes ``path`` (default
+    ``outdir/thesis_fig_1_3.png``) and returns it."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    hist, rows = io.read_history(outdir)
+    cols = {c: rows[:, i] for i, c in enumerate(hist["columns"])}
+    path = path or os.path.join(outdir, "thesis_fig_1_3.png")
+    label = {"symplectic": "SYM (sphgen)"}.get(hist.get("scheme"), f"sphgen {hist.get('scheme', 'wcsph')}")
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    ax.plot(cols["T"], cols["toe"], "k-", label=label)
+    Tv, Zv = reference.violeau_2012_dam_break_front()
+    Tk, Zk = reference.koshizuka_oka_1996_kincl()
+    ax.plot(Tv, Zv, "bo", mfc="none", label="VIO (Violeau 2012)")
+    ax.plot(Tk, Zk, "r^", mfc="none", label="EXP (Koshizuka & Oka 1996)")
+    ax.set_xlim(0, 3.2)
+    ax.set_ylim(1, 4)
+    ax.set_xlabel("$T = t\\sqrt{2g/a}$")
+    ax.set_ylabel("$X = x_{wave}/a$")
+    ax.set_title(f"dam break, dx = a/{int(round(L / hist['dx']))}")
+    ax.legend(loc="upper left")
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path
