@@ -394,12 +394,48 @@ def thesis_figure_1_3(outdir, path=None):
     ax.plot(Tv, Zv, "bo", mfc="none", label="VIO (Violeau 2012)")
     ax.plot(Tk, Zk, "r^", mfc="none", label="EXP (Koshizuka & Oka 1996)")
     ax.set_xlim(0, 3.2)
-    ax.set_ylim(1, 4)
+    ax.set_ylim(0.9, 4.1)
     ax.set_xlabel("$T = t\\sqrt{2g/a}$")
     ax.set_ylabel("$X = x_{wave}/a$")
     ax.set_title(f"dam break, dx = a/{int(round(L / hist['dx']))}")
     ax.legend(loc="upper left")
     fig.tight_layout()
     fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path
+
+
+def thesis_figure_1_2(outdir, path=None, times=(0.0, 0.2, 0.4, 0.6), walls=True):
+    """Kincl's thesis (2023), Fig. 1.2 from the output files of a finished ``dam_break_2d`` run in
+    ``outdir`` (run without ``--disable-output``): snapshots of the particles coloured by the
+    velocity magnitude, at the output times nearest ``times`` (s).  Writes ``path`` (default
+    ``outdir/thesis_fig_1_2.png``) and returns it."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from sphgen.tools.probes import output_series
+    series = list(output_series(outdir))
+    if not series:
+        raise InputError(f"thesis_figure_1_2: no output files in {outdir} (run without --disable-output)")
+    ts = np.array([t for t, _ in series])
+    picks = [series[int(np.argmin(np.abs(ts - t)))] for t in times]
+    vmax = max(float(np.hypot(a["fluid"].get("u"), a["fluid"].get("v")).max()) for _, a in picks) or 1.0
+    fig, axes = plt.subplots(1, len(picks), figsize=(3.2 * len(picks), 2.8), squeeze=False)
+    for ax, (t, arrays) in zip(axes[0], picks):
+        f = arrays["fluid"]
+        x, y = np.asarray(f.get("x")), np.asarray(f.get("y"))
+        speed = np.hypot(f.get("u"), f.get("v"))
+        sc = ax.scatter(x, y, c=speed, s=1.0, cmap="jet", vmin=0.0, vmax=vmax, linewidths=0)
+        if walls and "wall" in arrays:
+            ax.scatter(arrays["wall"].get("x"), arrays["wall"].get("y"), c="0.6", s=0.5, linewidths=0)
+        ax.set_aspect("equal")
+        ax.set_xlim(-0.1, TANK_W + 0.1)
+        ax.set_ylim(-0.1, 3.1)
+        ax.set_title(f"t = {t:.2f} s")
+        ax.set_xticks([])
+        ax.set_yticks([])
+    fig.colorbar(sc, ax=list(axes[0]), label="|v| (m/s)", shrink=0.8)
+    path = path or os.path.join(outdir, "thesis_fig_1_2.png")
+    fig.savefig(path, dpi=150, bbox_inches="tight")
     plt.close(fig)
     return path

@@ -111,11 +111,11 @@ def test_nu_zero_removes_the_viscous_update():
     assert s.get_integrator().steppers["fluid"].viscous == 0
 
 
-def run_app(tmp_path, *args):
+def run_app(tmp_path, *args, output=False):
     app = load_application("dam_break_2d")()
     out = tmp_path / "db"
-    app.run(["--scheme", "symplectic", "--no-progress", "--disable-output", "--threads", "1", "-d", str(out)]
-            + list(args))
+    app.run(["--scheme", "symplectic", "--no-progress", "--threads", "1", "-d", str(out)]
+            + ([] if output else ["--disable-output"]) + list(args))
     with open(out / "results.json") as f:
         res = json.load(f)
     with open(out / "history.json") as f:
@@ -127,7 +127,7 @@ def test_coarse_dam_break_stays_in_the_tank_and_the_toe_advances(tmp_path):
     """dx = L/20 to t = 0.2 s (T = 0.885): the thesis' set-up (g = 9.8, tank 4L x 3L, Wendland
     h = 1.5 dx, 3 wall layers, c0 = 50); fluid inside the tank, toe moving forward and
     near Violeau's curve, energy (kinetic + potential + fluid and wall internal) conserved."""
-    res, rows, app, out = run_app(tmp_path, "--dx", "0.05", "--tf", "0.2")
+    res, rows, app, out = run_app(tmp_path, "--dx", "0.05", "--tf", "0.2", "--pfreq", "200", output=True)
     s = app.scheme
     assert isinstance(s, SymplecticSPHScheme) and res["scheme"] == "symplectic"
     assert s.kernel.name == "wendland" and app.h == pytest.approx(1.5 * 0.05)
@@ -145,6 +145,8 @@ def test_coarse_dam_break_stays_in_the_tank_and_the_toe_advances(tmp_path):
     app_mod = sys.modules[type(app).__module__]
     png = app_mod.thesis_figure_1_3(str(out), str(tmp_path / "fig.png"))
     assert (tmp_path / "fig.png").exists() and png == str(tmp_path / "fig.png")
+    png = app_mod.thesis_figure_1_2(str(out), times=(0.0, 0.1, 0.2))
+    assert png.endswith("thesis_fig_1_2.png") and (out / "thesis_fig_1_2.png").exists()
 
 
 def test_reference_curves_of_the_thesis():
