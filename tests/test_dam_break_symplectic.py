@@ -9,23 +9,13 @@ import pytest
 
 from sphgen.app import load_application
 from sphgen.particles import ParticleArray
-from sphgen.scene import Scene
 from sphgen.schemes.symplectic import SymplecticSPHScheme
 from sphgen.tools import reference
 
-from conftest import assert_close, lattice_cloud
+from conftest import assert_close, lattice_cloud, march
+from test_shtc import build
 
 HDX = 1.5
-
-
-def build(arrays, scheme, backend):
-    scheme.setup_properties(arrays)
-    integ = scheme.get_integrator()
-    sc = Scene(arrays, scheme.get_equations(), steppers=integ.steppers, kernel=scheme.kernel,
-               dim=scheme.dim, outputs={pa.name: scheme.output_properties(pa) for pa in arrays},
-               backend=backend)
-    integ.attach(sc)
-    return sc, integ
 
 
 def cloud_and_wall(nx=10, seed=0, wall=True):
@@ -72,12 +62,7 @@ def run_steps(backend, steps=4):
     arrays, dx = cloud_and_wall(nx=8, seed=1)
     s = scheme_for(arrays, dx, nu=0.05, g=9.8)
     sc, integ = build(arrays, s, backend)
-    dt = s.get_timestep()
-    integ.initial_accelerations(0.0, dt)
-    t = 0.0
-    for _ in range(steps):
-        integ.one_timestep(t, dt)
-        t += dt
+    march(integ, s.get_timestep(), steps)
     return arrays, sc
 
 
