@@ -89,7 +89,7 @@ class SHTCKernelConvergence(Application):
     """Kernel interpolation error against h (Theorem 1 of Kincl's thesis): the O(h^2) slope."""
 
     dim = 2
-    kernels = ("wendland", "quintic")
+    kernels = ("wendland", "quintic", "gaussian", "quartic")
 
     def add_user_options(self, group):
         group.add_argument("--n", type=int, default=1024,
