@@ -12,13 +12,14 @@ the titles say so.  The captions of [P] Figs. 10-11 / [T] Figs. 2.4-2.5 give no 
 cavity's evolution is shown at ``CAVITY_TIMES`` (our choice, up to [T]'s t = 20).  Three
 figures of ours go beside them: ``T_thm1_convergence`` ([T] Theorem 1, the kernel-interpolation
 study), ``T_sec2_2_impulse_of_shear`` and ``P_sec3_6_reversibility`` (the applications' plots).
-[T] sec. 1.6's dam break (Figs. 1.2-1.3) has its slot (``dam_break_cases``,
-``dam_break_figures``) and is drawn as "not run" panels until its application lands.
+[T] sec. 1.6's dam break (Figs. 1.2-1.3) is ``dam_break_2d --scheme symplectic``, drawn by the
+application's ``thesis_figure_1_2`` and ``thesis_figure_1_3``.
 
 ``python automate.py shtc`` runs the paper preset (the papers' resolutions and steps; the
 cavity at Re 400 and 1000 with delta t = tau/3, below the relaxation guard's 0.464 tau),
-``python automate.py shtc_quick`` the quick one (coarse levels, the cavity with cs = 10 and
-delta t = tau/3 as docs/shtc.md's row 7; meant for under 30 minutes on 2 cores).  A figure whose
+``python automate.py shtc_quick`` the quick one (coarse levels; the cavity at Re 100 with cs = 10
+and delta t = tau/3 as docs/shtc.md's row 7, at Re 400 and 1000 with cs = 5 so that delta t = tau/3
+is four times larger; meant for under 30 minutes on 2 cores).  A figure whose
 runs are missing is drawn with "not run" panels.  ``python -m automation.shtc [outputs] [quick]``
 redraws from finished runs.
 """
@@ -42,16 +43,22 @@ CAVITY_RE = (100, 400, 1000)
 
 CONFIG = {
     # the papers' parameters: plate W/40, column n = 16, Taylor-Couette 1/30 ([P] Table 1), the
-    # cavity at nx = 200, cs = 20 (Table 1), delta t = 1.5e-5 at Re 100 (Table 1); at Re 400 and 1000
-    # delta t = tau/3 (Table 1's step is 0.4 tau at Re 400 and refused at Re 1000)
+    # cavity (re, nx, cs, delta t) at nx = 200, cs = 20 (Table 1), delta t = 1.5e-5 at Re 100 (Table 1);
+    # at Re 400 and 1000 delta t = tau/3 (Table 1's step is 0.4 tau at Re 400 and refused at Re 1000);
+    # the dam break at dr = a/100 (the authors' code), an output every 1667 steps of 6e-5 s (0.1 s)
     "paper": dict(plate_nw=40, plate_pfreq=2764, column_n=16, column_pfreq=4840, couette_nr=30,
-                  cavity_cs="20", cavity=((100, 200, "1.5e-05"), (400, 200, "1.25e-05"), (1000, 200, "5e-06")),
+                  cavity=((100, 200, "20", "1.5e-05"), (400, 200, "20", "1.25e-05"), (1000, 200, "20", "5e-06")),
                   kernel_args=[], impulse_args=["--nx", "80"],
-                  reversibility_args=["--amplitude", "5", "--perturb", "0.1", "--steps", "1000"]),
-    # coarse levels; the cavity as docs/shtc.md row 7 (cs = 10, delta t = tau/3 = 2e-3/Re)
+                  reversibility_args=["--amplitude", "5", "--perturb", "0.1", "--steps", "1000"],
+                  dam_break_dx="0.01", dam_break_pfreq=1667),
+    # coarse levels; the cavity at Re 100 as docs/shtc.md row 7 (cs = 10, delta t = tau/3 = 2e-4), at
+    # Re 400 and 1000 with cs = 5 (tau = 6 nu / cs^2 four times larger, delta t = tau/3: 100 k and 250 k
+    # steps instead of 400 k and 1 M; the Navier-Stokes limit does not depend on cs while tau << 1);
+    # the kernel study on 512^2 with h >= 8 lattice spacings (the test's h); the dam break at a/50
     "quick": dict(plate_nw=10, plate_pfreq=692, column_n=4, column_pfreq=1210, couette_nr=10,
-                  cavity_cs="10", cavity=((100, 40, "0.0002"), (400, 40, "5e-05"), (1000, 30, "2e-05")),
-                  kernel_args=["--n", "512"], impulse_args=[], reversibility_args=[]),
+                  cavity=((100, 40, "10", "0.0002"), (400, 40, "5", "0.0002"), (1000, 30, "5", "8e-05")),
+                  kernel_args=["--n", "512", "--h", "0.016", "0.022", "0.032", "0.045"], impulse_args=[],
+                  reversibility_args=[], dam_break_dx="0.02", dam_break_pfreq=833),
 }
 
 
@@ -82,8 +89,8 @@ def couette_cases(cfg):
 def cavity_cases(cfg):
     """Re 100 (with the snapshots of Figs. 10-11), 400 and 1000, all to t = 20."""
     out = {}
-    for re, nx, dt in cfg["cavity"]:
-        args = ["--nx", str(nx), "--re", str(re), "--cs", cfg["cavity_cs"], "--dt", dt]
+    for re, nx, cs, dt in cfg["cavity"]:
+        args = ["--nx", str(nx), "--re", str(re), "--cs", cs, "--dt", dt]
         if re == 100:
             args += ["--pfreq", str(cavity_pfreq(dt))]
         out[cavity_name(re, nx)] = ("shtc_cavity", args)
@@ -98,8 +105,9 @@ def thesis_cases(cfg):
 
 
 def dam_break_cases(cfg):
-    """[T] sec. 1.6's dam break (Figs. 1.2-1.3): added by the lead when the thesis dam break lands."""
-    return {}
+    """[T] sec. 1.6's dam break (Figs. 1.2-1.3) with the thesis' method, to t = 0.7 s (T = 3.1)."""
+    return {"dam_break": ("dam_break_2d", ["--scheme", "symplectic", "--dx", cfg["dam_break_dx"],
+                                           "--pfreq", str(cfg["dam_break_pfreq"])])}
 
 
 SECTIONS = (plate_cases, column_cases, couette_cases, cavity_cases, thesis_cases, dam_break_cases)
@@ -299,6 +307,7 @@ def _pressure(fig, ax, pa, title):
 
 # ------------------------------------------------------------------ column
 def column_figures(sim_dir, out_dir, cfg):
+    from sphgen.applications.twisting_column import H
     plt = _plt()
     run = os.path.join(sim_dir, "column")
     shots = nearest(outputs(run, "twisting_column"), COLUMN_TIMES)
@@ -308,7 +317,7 @@ def column_figures(sim_dir, out_dir, cfg):
             _not_run(ax, f"t = {t:g} s")
             continue
         pa = shots[t][0]["column"]
-        size = float(np.clip(3000.0 / max(pa.n, 1), 0.3, 10.0))
+        size = float(np.clip(12000.0 / max(pa.n, 1), 0.3, 20.0))
         p = _prop(pa, "p")
         lo, hi = np.percentile(p, [1, 99])
         sc = ax.scatter(_prop(pa, "x"), _prop(pa, "z"), c=p, s=size, cmap="coolwarm", vmin=lo, vmax=hi)
@@ -333,7 +342,7 @@ def column_figures(sim_dir, out_dir, cfg):
     if h is None:
         _not_run(ax)
     else:
-        ax.plot(h["t"], h["z_top"], "C1-", label="SHTC-SPH (sphgen)")
+        ax.plot(h["t"], h["z_top"] / H, "C1-", label="SHTC-SPH (sphgen)")
         ax.legend(fontsize=7)
     ax.set_xlabel("t [s]")
     ax.set_ylabel("z / H of the point initially at (0, 0, H)")
@@ -388,15 +397,18 @@ def _field(fig, ax, arrays, names, what, title, lim=None):
     x = np.concatenate([_prop(pa, "x") for pa in pas])
     y = np.concatenate([_prop(pa, "y") for pa in pas])
     c = np.concatenate([_value(pa, what) for pa in pas])
-    size = float(np.clip(6000.0 / max(x.size, 1), 0.3, 12.0))
+    size = float(np.clip(30000.0 / max(x.size, 1), 0.3, 30.0))   # about one marker per particle spacing
     if lim is None and what == "Axy":
         m = float(np.percentile(np.abs(c), 99)) or 1.0
         lim = (-m, m)
-    sc = ax.scatter(x, y, c=c, s=size, cmap="viridis" if what == "speed" else "RdBu_r",
-                    vmin=None if lim is None else lim[0], vmax=None if lim is None else lim[1])
+    if lim is None and what == "speed":
+        lim = (0.0, 1.0)           # up to the lid's speed, the same scale in every panel
+    sc = ax.scatter(x, y, c=c, s=size, cmap="viridis" if what == "speed" else "RdBu_r", vmin=lim[0], vmax=lim[1],
+                    linewidths=0)
     ax.set_aspect("equal")
     ax.set_title(title, fontsize=8)
-    fig.colorbar(sc, ax=ax, shrink=0.7, label="|v|" if what == "speed" else "$A_{xy}$")
+    fig.colorbar(sc, ax=ax, shrink=0.7, extend="max" if what == "speed" else "neither",
+                 label="|v| (lid: 1)" if what == "speed" else "$A_{xy}$")
     return {"min": float(c.min()), "max": float(c.max())}
 
 
@@ -419,7 +431,7 @@ def cavity_evolution(out_dir, name, folder, what, suptitle):
     return shown
 
 
-def _centrelines(ax_u, ax_v, res, ghia, re):
+def _centrelines(ax_u, ax_v, res, ghia, re, cs):
     """v_x on x = 1/2 against y and v_y on y = 1/2 against x: the run's (at the end, and averaged
     over the second half of the run) and Ghia et al. (1982)."""
     ax_u.plot(ghia["u"], ghia["y"], "ks", mfc="none", ms=4, label="Ghia et al. (1982)")
@@ -437,18 +449,20 @@ def _centrelines(ax_u, ax_v, res, ghia, re):
     err = f"max dev. {res['ghia_error']:.3f}" + (f", mean {res['ghia_error_averaged']:.3f}"
                                                  if "ghia_error_averaged" in res else "")
     ax_u.set_title(f"Re = {re}, nx = {res.get('nx')}: {err}", fontsize=7)
-    ax_v.set_title(f"Re = {re}, nx = {res.get('nx')}", fontsize=7)
+    ax_v.set_title(f"Re = {re}, nx = {res.get('nx')}, cs = {cs}, dt/tau = {res.get('dt_over_tau') or 0:.3g}",
+                   fontsize=7)
 
 
 def centreline_figure(out_dir, name, sim_dir, cfg, res_list, suptitle):
     from sphgen.tools.reference import ghia_1982
     plt = _plt()
-    runs = {re: os.path.join(sim_dir, cavity_name(re, nx)) for re, nx, _ in cfg["cavity"]}
+    runs = {re: os.path.join(sim_dir, cavity_name(re, nx)) for re, nx, _, _ in cfg["cavity"]}
+    speeds = {re: cs for re, _, cs, _ in cfg["cavity"]}
     fig, axes = plt.subplots(2, len(res_list), figsize=(4.2 * len(res_list), 7.2), squeeze=False)
     out = {}
     for k, re in enumerate(res_list):
         res = _json(runs[re], "results.json")
-        _centrelines(axes[0][k], axes[1][k], res, ghia_1982(re), re)
+        _centrelines(axes[0][k], axes[1][k], res, ghia_1982(re), re, speeds[re])
         axes[0][k].set_xlabel("$v_x$ on x = 1/2")
         axes[0][k].set_ylabel("y")
         axes[1][k].set_xlabel("x")
@@ -490,15 +504,31 @@ def thesis_figures(sim_dir, out_dir, cfg):
             for (k, v), f in zip(got.items(), ("kernel_convergence", "impulse_of_shear", "reversibility"))}
 
 
+DAM_BREAK_KEYS = ("dx", "t", "T", "toe_max_rel_dev_violeau", "toe_signed_dev_at_max_violeau",
+                  "toe_max_rel_dev_koshizuka_oka_kincl", "toe_max_rel_dev_koshizuka_oka",
+                  "toe_max_rel_dev_koshizuka_oka_mps", "energy_change_rel", "mass_drift", "n_outside_final")
+
+
 def dam_break_figures(sim_dir, out_dir, cfg):
-    """[T] Figs. 1.2 (snapshots, |v|) and 1.3 (the wavefront against Koshizuka & Oka and Violeau):
-    added by the lead when the thesis dam break lands; until then "not run" panels."""
-    plt = _plt()
-    for name, title in (("T_fig1_2", "[T] Fig. 1.2: dam break snapshots, |v|"),
-                        ("T_fig1_3", "[T] Fig. 1.3: wavefront x/a against T")):
-        fig, ax = plt.subplots(figsize=(5, 3))
-        _not_run(ax, title + " (the thesis' dam break application has not landed)")
-        _save(fig, out_dir, name)
+    """[T] Figs. 1.2 (snapshots, |v|) and 1.3 (the wavefront against Violeau and Koshizuka & Oka),
+    drawn by the dam break application from its run; "not run" panels without one."""
+    from sphgen.applications.dam_break_2d import thesis_figure_1_2, thesis_figure_1_3
+    run = os.path.join(sim_dir, "dam_break")
+    done = _json(run, "info.json") or {}
+    for name, draw, title in (("T_fig1_2", thesis_figure_1_2, "[T] Fig. 1.2: dam break snapshots, |v|"),
+                              ("T_fig1_3", thesis_figure_1_3, "[T] Fig. 1.3: wavefront x/a against T")):
+        if done.get("completed"):
+            os.makedirs(os.path.join(out_dir, name), exist_ok=True)
+            draw(run, os.path.join(out_dir, name, name + ".png"))
+        else:
+            plt = _plt()
+            fig, ax = plt.subplots(figsize=(5, 3))
+            _not_run(ax, title)
+            _save(fig, out_dir, name)
+    res = _json(run, "results.json")
+    out = {k: res.get(k) for k in DAM_BREAK_KEYS} if res else None
+    _dump(out_dir, "T_fig1_3", out or {})
+    return out
 
 
 def figures(sim_dir, out_dir, cfg):
