@@ -119,7 +119,11 @@ class SHTCKernelConvergence(Application):
         self.outdir = opts.directory or f"{self.name}_output"
         run_folder.check_output_folder(self.outdir, opts.overwrite)
         run_folder.prepare_output_folder(self.outdir, opts.overwrite)
-        return self.post_process(self.outdir)
+        results = self.post_process(self.outdir)
+        # a finished run, as the time-loop applications mark theirs (automan does not run it again)
+        io.write_json(os.path.join(self.outdir, "info.json"), {"completed": True, "error": None,
+                                                               "options": vars(opts)})
+        return results
 
     def post_process(self, outdir):
         """results.json (errors per h, slope, Theorem 1's bound per kernel) and convergence.png."""

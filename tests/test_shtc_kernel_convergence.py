@@ -34,6 +34,7 @@ def test_application_writes_results_and_plot(tmp_path):
     assert set(res["kernels"]) == {"wendland", "quintic", "gaussian", "quartic"}
     assert abs(res["kernels"]["wendland"]["slope"] - 2.0) <= 0.2
     assert (out / "convergence.png").stat().st_size > 0
+    assert json.load(open(out / "info.json"))["completed"] is True      # automan's "finished"
 
 
 def test_too_coarse_a_lattice_is_refused(tmp_path):
