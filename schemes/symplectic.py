@@ -47,7 +47,8 @@ class ViscousVerletStep(IntegratorStep):
         self.dim, self.viscous = int(dim), int(viscous)
 
     def stage1(self, d_idx, d_u, d_v, d_w, d_au, d_av, d_aw, dt):
-        """v(k+1/2) = v(k) + dt/2 f(k)/m."""
+        """v(k+1/2) = v(k) + dt/2 f(k)/m, and v(k+1) = v~ + dt/2 f(k+1)/m (the kicks of
+        SHTCIntegrator)."""
         add_scaled(d_idx, self.dim, 0.5 * dt, d_u, d_v, d_w, d_au, d_av, d_aw)
 
     def stage2(self, d_idx, d_x, d_y, d_z, d_u, d_v, d_w, dt):
@@ -59,10 +60,6 @@ class ViscousVerletStep(IntegratorStep):
         if self.viscous:
             add_scaled(d_idx, self.dim, dt, d_u, d_v, d_w, d_auv, d_avv, d_awv)
         add_scaled(d_idx, self.dim, 0.5 * dt, d_x, d_y, d_z, d_u, d_v, d_w)
-
-    def stage4(self, d_idx, d_u, d_v, d_w, d_au, d_av, d_aw, dt):
-        """v(k+1) = v~ + dt/2 f(k+1)/m."""
-        add_scaled(d_idx, self.dim, 0.5 * dt, d_u, d_v, d_w, d_au, d_av, d_aw)
 
 
 class ViscousVerlet(SHTCIntegrator):
