@@ -2,7 +2,8 @@
 """Regenerate every figure: ``python automate.py`` (automan; see ``--help``).
 
 ``python automate.py variational`` (or ``ctvf``, ``ctvf_solids_quick``, ``edac``, ``superfluid``,
-``superfluid_quick``, ``thermo``, ``thermo_quick``) regenerates one paper's figures;
+``superfluid_quick``, ``thermo``, ``thermo_quick``, ``shtc``,
+``shtc_quick``) regenerates one paper's figures;
 automan's own names work too: a problem's class name (``VariationalOrder``) or its output
 folder name (``ctvf_fig13_cavity``).  Simulations go to ``outputs/``, figures to
 ``manuscript/figures/``.  Finished cases (``info.json`` with ``completed: true``) are not
@@ -16,6 +17,7 @@ from automation.ctvf_cavity import CTVFCavityVoid
 from automation.ctvf_solids import PAPER_PROBLEMS as CTVF_SOLIDS, QUICK_PROBLEMS as CTVF_SOLIDS_QUICK
 from automation.ctvf_taylor_green import CTVFTaylorGreen
 from automation.taylor_green import TaylorGreenEDAC
+from automation.shtc import PAPER_PROBLEMS as SHTC, QUICK_PROBLEMS as SHTC_QUICK
 from automation.superfluid import Superfluid, SuperfluidQuick
 from automation.thermo import PAPER_PROBLEMS as THERMO, QUICK_PROBLEMS as THERMO_QUICK
 from automation.variational import VariationalDamBreak, VariationalEjection, VariationalEnergy, VariationalOrder
@@ -30,6 +32,8 @@ PAPERS = {
     "superfluid_quick": [SuperfluidQuick],
     "thermo": THERMO,
     "thermo_quick": THERMO_QUICK,
+    "shtc": SHTC,
+    "shtc_quick": SHTC_QUICK,
 }
 PROBLEMS = [cls for group in PAPERS.values() for cls in group]
 

@@ -30,7 +30,7 @@ from sphgen.errors import InputError
 from sphgen.particles import ParticleArray
 from sphgen.tools.probes import pairs_within
 
-from ..schemes.shtc import SHTCScheme
+from ..schemes.shtc import SHTC_INTEGRATORS, SHTCScheme
 from ._solid_plots import plot_energy, plot_track
 from ._perturbation import add_perturbation_options, check_perturbation, perturbed
 
@@ -201,6 +201,9 @@ class BerylliumPlate(Application):
         group.add_argument("--rho0", type=float, default=RHO0, help="density (thesis: 1850 kg/m^3)")
         group.add_argument("--samples-per-period", type=int, default=400,
                            help="history samples per linear period 2 pi/omega (default %(default)s)")
+        group.add_argument("--integrator", choices=SHTC_INTEGRATORS, default="verlet",
+                           help="time integrator (Kincl 2023, thesis sec. 1.4; the paper's eq. 25 is verlet; "
+                                "default %(default)s)")
         add_perturbation_options(group)
 
     def consume_user_options(self, o):
@@ -229,7 +232,8 @@ class BerylliumPlate(Application):
 
     def create_scheme(self):
         return SHTCScheme(["plate"], 2, rho0=self.rho0, c0=C0, cs=C0, h=HDR * self.dr, dr=self.dr,
-                          tau=math.inf, model="dprz", cp=self.options.cp_factor * C0)
+                          tau=math.inf, model="dprz", cp=self.options.cp_factor * C0,
+                          integrator=self.options.integrator)
 
     def post_step(self, solver):
         every = max(1, int(round(2 * math.pi / OMEGA / self.options.samples_per_period / solver.dt)))
@@ -252,7 +256,7 @@ class BerylliumPlate(Application):
 
     def history_meta(self):
         o = self.options
-        return {"nw": o.nw, "cp_factor": o.cp_factor, "rho0": self.rho0, "dr": self.dr,
+        return {"nw": o.nw, "cp_factor": o.cp_factor, "rho0": self.rho0, "dr": self.dr, "integrator": o.integrator,
                 "perturb": o.perturb, "seed": o.seed}
 
     def post_process(self, outdir):

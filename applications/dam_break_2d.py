@@ -30,6 +30,18 @@ geometry (:class:`~schemes.variational.VariationalScheme`): ``--integrator varia
 density (eq. 67), AV of eq. 55 with a = ``--alpha`` (0.1) and b = 0, the walls' first layers as
 the repulsive boundary particles of eq. 58 (D = 2 g H, r0 = dx); delta-SPH is not used.
 
+``--scheme symplectic`` runs the method of Kincl's thesis (2023, §1.6, the "SYM" curve of its
+Fig. 1.3; :class:`~schemes.symplectic.SymplecticSPHScheme`): summation density with the
+constant that makes rho = rho0 at t = 0 (eq. 1.14), Tait (eq. 1.15), physical viscosity
+nu = 1e-6 (eq. 1.81, ``--nu``), the viscous Verlet step (eq. 1.82), dummy no-slip walls that
+are fluid particles at rest (ceil(2h/dx) layers, eq. 1.83); the thesis' tank (4L x 3L, open
+top), g = 9.8, column at rho0 and p = 0; Wendland kernel with h = 1.5 dx, c0 = 50 m/s
+(``--c0``) and dt = 0.2 h/c0 from the authors' code (the thesis gives none of them; docs/shtc.md,
+"Thesis §1.6 dam break").  Its toe is also compared with Violeau's (2012) curve and Kincl's
+digitisation of Koshizuka & Oka, both from the authors' repository
+(:func:`sphgen.tools.reference.violeau_2012_dam_break_front`); :func:`thesis_figure_1_3`
+draws the thesis' Fig. 1.3 from a finished run.
+
 ``post_process`` writes ``results.json``: the toe position Z = x_toe/L against T (largest x
 of the fluid within 2 dx of the floor, ejected particles ignored,
 :func:`sphgen.tools.probes.front_position`), its largest relative deviation from Martin &
@@ -53,6 +65,7 @@ from sphgen.tools.probes import front_position
 from sphgen.tools import reference
 
 from ..schemes.ctvf import CTVFScheme
+from ..schemes.symplectic import SymplecticSPHScheme
 from ..schemes.variational import VariationalScheme
 from ..schemes.wcsph import WCSPHScheme
 
@@ -67,13 +80,17 @@ TANK_W = 4.0 * L   # tank width
 TANK_H = 4.0 * L   # tank height (PySPH's container_height)
 RHO0 = 1000.0
 G = 9.81
+G_THESIS = 9.8     # Kincl (2023), §1.6
+TANK_H_THESIS = 3.0 * L   # Kincl (2023), §1.6: container (0, 4a) x (0, 3a)
+C0_THESIS = 50.0   # the authors' code (SmoothedParticles.jl, collapse_symplectic.jl); not in the thesis
 T_RANGE = (0.8, 3.0)  # where the toe is compared with the experiments
+VIOLEAU_RANGE = (0.0, 3.01)  # Violeau's curve: its whole data range (T <= 3.005)
 MPS_RANGE = (0.0, 2.95)  # Koshizuka & Oka's MPS curve: its whole data range (T <= 2.943)
 
 
-def toe_scale():
+def toe_scale(g=G):
     """T = t * toe_scale() = t sqrt(2 g / L)."""
-    return sqrt(2.0 * G / L)
+    return sqrt(2.0 * g / L)
 
 
 def max_rel_deviation(T, Z, T_ref, Z_ref, lo=T_RANGE[0], hi=T_RANGE[1]):
@@ -106,11 +123,13 @@ class DamBreak2D(Application):
     def add_user_options(self, group):
         group.add_argument("--dx", type=float, default=0.03,
                            help="particle spacing, rounded so that L/dx is whole (default %(default)s)")
-        group.add_argument("--hdx", type=float, default=1.0, help="h / dx (default %(default)s)")
-        group.add_argument("--kernel", choices=("quintic", "wendland"), default="quintic",
+        group.add_argument("--hdx", type=float, default=None,
+                           help="h / dx (default 1, 1.5 for --scheme symplectic)")
+        group.add_argument("--kernel", choices=("quintic", "wendland"), default=None,
                            help="kernel: quintic spline (support 3h) or Wendland C2 (support 2h; PySPH's "
-                                "dam_break_2d uses it with --hdx 1.3) (default %(default)s)")
-        group.add_argument("--scheme", choices=("wcsph", "ctvf", "variational"), default="wcsph",
+                                "dam_break_2d uses it with --hdx 1.3) (default quintic; wendland for "
+                                "--scheme symplectic, Kincl 2023 eq. 1.6)")
+        group.add_argument("--scheme", choices=("wcsph", "ctvf", "variational", "symplectic"), default="wcsph",
                            help="scheme (default %(default)s)")
         group.add_argument("--integrator", choices=("variational", "explicit"), default="variational",
                            help="--scheme variational: midpoint (eqs. 37, 63-65) or leapfrog (59-62)")
@@ -123,9 +142,13 @@ class DamBreak2D(Application):
                                 "eq. 55), 0.05 for ctvf)")
         group.add_argument("--no-surface-pressure", dest="surface_pressure", action="store_false",
                            help="ctvf: do not hold p = 0 on the free-surface particles")
-        group.add_argument("--nu", type=float, default=0.0,
+        group.add_argument("--nu", type=float, default=None,
                            help="ctvf: kinematic viscosity, m^2/s, with the no-slip wall ghost velocity "
-                                "(default %(default)s; water 1e-6)")
+                                "(default 0; water 1e-6); symplectic: eq. 1.81 viscosity (default 1e-6, "
+                                "Kincl 2023 §1.6)")
+        group.add_argument("--c0", type=float, default=None,
+                           help="sound speed, m/s, instead of --c0-factor (default for --scheme "
+                                f"symplectic: {C0_THESIS:g}, the authors' code)")
         group.add_argument("--edac-damping", choices=("consistent", "paper"), default="consistent",
                            help="ctvf: the pressure damping of eq. 26 as a Laplacian (default) or as printed "
                                 "(an extra 1/rho: 1000 times weaker for water)")
@@ -144,6 +167,11 @@ class DamBreak2D(Application):
                            help="time between toe/energy samples (default %(default)s s)")
 
     def consume_user_options(self, o):
+        thesis = o.scheme == "symplectic"
+        if o.kernel is None:
+            o.kernel = "wendland" if thesis else "quintic"   # Kincl 2023 eq. 1.6
+        if o.hdx is None:
+            o.hdx = 1.5 if thesis else 1.0                    # the authors' code: support 3 dx
         for name in ("dx", "hdx", "c0_factor", "record_every"):
             v = getattr(o, name)
             if not (np.isfinite(v) and v > 0):
@@ -154,6 +182,16 @@ class DamBreak2D(Application):
         if o.scheme == "variational" and o.kernel != "quintic":
             raise InputError("--scheme variational uses its own kernel (da Silva & Giraldi 2024, eq. 69 "
                              "variants); drop --kernel")
+        if o.nu is None:
+            o.nu = 1e-6 if o.scheme == "symplectic" else 0.0
+        if o.c0 is None and o.scheme == "symplectic":
+            o.c0 = C0_THESIS
+        if o.c0 is not None and not (np.isfinite(o.c0) and o.c0 > 0):
+            raise InputError(f"--c0 must be a positive finite number, got {o.c0}")
+        if not (np.isfinite(o.nu) and o.nu >= 0):
+            raise InputError(f"--nu must be a non-negative finite number, got {o.nu}")
+        # the thesis' tank and g for its method; PySPH's for the others
+        self.g, self.tank_h = (G_THESIS, TANK_H_THESIS) if o.scheme == "symplectic" else (G, TANK_H)
         if o.alpha is None:
             o.alpha = 0.05 if o.scheme == "ctvf" else 0.1
         if o.scheme == "ctvf":   # no equation of state: no internal energy to sample
@@ -171,7 +209,7 @@ class DamBreak2D(Application):
         self.h = o.hdx * self.dx
         if o.scheme == "variational":   # the Gaussian's neighbour radius sets h (rc = 3h)
             self.h = VariationalScheme(["fluid"], [], dx=self.dx).h
-        self.c0 = o.c0_factor * sqrt(2.0 * G * H)
+        self.c0 = o.c0 if o.c0 is not None else o.c0_factor * sqrt(2.0 * G * H)
         self.n_layers = layers_for_support(get_kernel(o.kernel, 2), o.hdx)
         self.history = []
         self._next_record = 0.0
@@ -181,12 +219,12 @@ class DamBreak2D(Application):
         x, y = rectangle(0.0, L, 0.0, H, dx)
         b = RHO0 * self.c0 ** 2 / 7.0
         p = RHO0 * G * (H - y)
-        if self.options.initial_state == "uniform":
-            p = 0.0 * y
+        if self.options.initial_state == "uniform" or self.options.scheme == "symplectic":
+            p = 0.0 * y    # the symplectic scheme's density constant makes rho = rho0 at t = 0
         rho = RHO0 * (1.0 + p / b) ** (1.0 / 7.0)
         fluid = ParticleArray("fluid", x=x, y=y, rho=rho, m=rho * dx * dx, h=np.full(x.size, h))
         fluid.add_property("p", data=p)
-        xw, yw, nx, ny = wall_layers_box(0.0, TANK_W, 0.0, TANK_H, dx, self.n_layers, open_top=True)
+        xw, yw, nx, ny = wall_layers_box(0.0, TANK_W, 0.0, self.tank_h, dx, self.n_layers, open_top=True)
         wall = ParticleArray("wall", x=xw, y=yw, rho=np.full(xw.size, RHO0),
                              m=np.full(xw.size, RHO0 * dx * dx), h=np.full(xw.size, h))
         wall.add_property("normal", stride=3, data=np.column_stack([nx, ny, 0 * nx]).ravel())
@@ -195,6 +233,9 @@ class DamBreak2D(Application):
 
     def create_scheme(self):
         o = self.options
+        if o.scheme == "symplectic":
+            return SymplecticSPHScheme(["fluid"], ["wall"], dim=2, rho0=RHO0, c0=self.c0, h=self.h, nu=o.nu,
+                                       gy=-self.g, kernel=o.kernel)
         if o.scheme == "ctvf":
             return CTVFScheme(["fluid"], dim=2, rho0=RHO0, c0=self.c0, nu=o.nu, h=self.h, dx=self.dx,
                               umax=sqrt(2.0 * G * H), density="continuity", alpha=o.alpha, gy=-G,
@@ -210,7 +251,8 @@ class DamBreak2D(Application):
                            umax=sqrt(2.0 * G * H), wall_alpha=bool(o.wall_alpha), kernel=o.kernel)
 
     def history_meta(self):
-        return {"dx": self.dx, "h": self.h, "c0": self.c0, "L": L, "m0": self.m0, "scheme": self.options.scheme}
+        return {"dx": self.dx, "h": self.h, "c0": self.c0, "L": L, "m0": self.m0, "scheme": self.options.scheme,
+                "g": self.g}
 
     # ------------------------------------------------------------ diagnostics
     def post_step(self, solver):
@@ -221,15 +263,17 @@ class DamBreak2D(Application):
     def record(self, t):
         f = self.scene.by_name["fluid"]
         e = self.energies(f)
-        self.history.append([t, t * toe_scale(), *self.row(f, self.dx), e["kinetic"], e["potential"],
+        self.history.append([t, t * toe_scale(self.g), *self.row(f, self.dx), e["kinetic"], e["potential"],
                              e["internal"], e["total"], *self.mass_row(f)])
 
     def energies(self, f):
         """The scheme's energies; kinetic and potential only for a scheme without them (EDAC)."""
+        if isinstance(self.scheme, SymplecticSPHScheme):   # its walls hold internal energy
+            return self.scheme.energies([f, self.scene.by_name["wall"]])
         if hasattr(self.scheme, "energies"):
             return self.scheme.energies([f])
         ke = 0.5 * float(np.sum(f.m * (f.u ** 2 + f.v ** 2)))
-        pe = float(np.sum(f.m * G * f.y))
+        pe = float(np.sum(f.m * self.g * f.y))
         return {"kinetic": ke, "potential": pe, "internal": 0.0, "total": ke + pe}
 
     @staticmethod
@@ -259,9 +303,12 @@ class DamBreak2D(Application):
         refs = {"martin_moyce_a2.25in": reference.martin_moyce_1952(2.25),
                 "martin_moyce_a1.125in": reference.martin_moyce_1952(1.125),
                 "koshizuka_oka": reference.koshizuka_oka_1996(),
-                "koshizuka_oka_mps": reference.koshizuka_oka_1996_mps()}
+                "koshizuka_oka_mps": reference.koshizuka_oka_1996_mps(),
+                "violeau": reference.violeau_2012_dam_break_front(),
+                "koshizuka_oka_kincl": reference.koshizuka_oka_1996_kincl()}
+        ranges = {"koshizuka_oka_mps": MPS_RANGE, "violeau": VIOLEAU_RANGE}
         for name, (Tr, Zr) in refs.items():
-            lo, hi = MPS_RANGE if name == "koshizuka_oka_mps" else T_RANGE
+            lo, hi = ranges.get(name, T_RANGE)
             dev, signed = max_rel_deviation(T[ok], Z[ok], np.asarray(Tr), np.asarray(Zr), lo, hi)
             results[f"toe_max_rel_dev_{name}"] = dev
             results[f"toe_signed_dev_at_max_{name}"] = signed
@@ -283,6 +330,7 @@ class DamBreak2D(Application):
               f"Martin-Moyce (a=2.25in) {_pct(results['toe_max_rel_dev_martin_moyce_a2.25in'])}, "
               f"Koshizuka-Oka (experiment) {_pct(results['toe_max_rel_dev_koshizuka_oka'])}; over "
               f"T <= {MPS_RANGE[1]}: Koshizuka-Oka MPS {_pct(results['toe_max_rel_dev_koshizuka_oka_mps'])}; "
+              f"T <= {VIOLEAU_RANGE[1]}: Violeau {_pct(results['toe_max_rel_dev_violeau'])}; "
               f"mass drift {results['mass_drift']:.2e}, outside {results['n_outside_final']}\n"
               f"results: {os.path.join(outdir, 'results.json')}\nfigures: {os.path.join(outdir, 'toe.png')}, "
               f"{os.path.join(outdir, 'energy.png')}")
@@ -298,7 +346,9 @@ class DamBreak2D(Application):
         marks = {"martin_moyce_a2.25in": ("bo", "Martin & Moyce 1952 (a = 2.25 in)"),
                  "martin_moyce_a1.125in": ("bs", "Martin & Moyce 1952 (a = 1.125 in)"),
                  "koshizuka_oka": ("r^", "Koshizuka & Oka 1996 (experiment)"),
-                 "koshizuka_oka_mps": ("gv", "Koshizuka & Oka 1996 (MPS)")}
+                 "koshizuka_oka_mps": ("gv", "Koshizuka & Oka 1996 (MPS)"),
+                 "violeau": ("mD", "Violeau 2012 (SPH; Kincl's digitisation)"),
+                 "koshizuka_oka_kincl": ("c<", "Koshizuka & Oka 1996 (Kincl's digitisation)")}
         for name, (Tr, Zr) in refs.items():
             ax.plot(Tr, Zr, marks[name][0], mfc="none", label=marks[name][1])
         ax.axvspan(*T_RANGE, color="0.93", zorder=0)
@@ -322,3 +372,70 @@ class DamBreak2D(Application):
         fig.tight_layout()
         fig.savefig(os.path.join(outdir, "energy.png"), dpi=100)
         plt.close(fig)
+
+
+def thesis_figure_1_3(outdir, path=None):
+    """Kincl's thesis (2023), Fig. 1.3 from a finished ``dam_break_2d`` run in ``outdir``: the
+    toe X = x_wave/a against T = t sqrt(2g/a) (the thesis prints t/sqrt(2ga)) of the run ("SYM"
+    for ``--scheme symplectic``), Violeau's (2012) curve ("VIO") and Koshizuka & Oka's (1996)
+    experiment ("EXP"), both as Kincl digitised them.  Writes ``path`` (default
+    ``outdir/thesis_fig_1_3.png``) and returns it."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    hist, rows = io.read_history(outdir)
+    cols = {c: rows[:, i] for i, c in enumerate(hist["columns"])}
+    path = path or os.path.join(outdir, "thesis_fig_1_3.png")
+    label = {"symplectic": "SYM (sphgen)"}.get(hist.get("scheme"), f"sphgen {hist.get('scheme', 'wcsph')}")
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    ax.plot(cols["T"], cols["toe"], "k-", label=label)
+    Tv, Zv = reference.violeau_2012_dam_break_front()
+    Tk, Zk = reference.koshizuka_oka_1996_kincl()
+    ax.plot(Tv, Zv, "bo", mfc="none", label="VIO (Violeau 2012)")
+    ax.plot(Tk, Zk, "r^", mfc="none", label="EXP (Koshizuka & Oka 1996)")
+    ax.set_xlim(0, 3.2)
+    ax.set_ylim(0.9, 4.1)
+    ax.set_xlabel("$T = t\\sqrt{2g/a}$")
+    ax.set_ylabel("$X = x_{wave}/a$")
+    ax.set_title(f"dam break, dx = a/{int(round(L / hist['dx']))}")
+    ax.legend(loc="upper left")
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path
+
+
+def thesis_figure_1_2(outdir, path=None, times=(0.0, 0.2, 0.4, 0.6), walls=True):
+    """Kincl's thesis (2023), Fig. 1.2 from the output files of a finished ``dam_break_2d`` run in
+    ``outdir`` (run without ``--disable-output``): snapshots of the particles coloured by the
+    velocity magnitude, at the output times nearest ``times`` (s).  Writes ``path`` (default
+    ``outdir/thesis_fig_1_2.png``) and returns it."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from sphgen.tools.probes import output_series
+    series = list(output_series(outdir))
+    if not series:
+        raise InputError(f"thesis_figure_1_2: no output files in {outdir} (run without --disable-output)")
+    ts = np.array([t for t, _ in series])
+    picks = [series[int(np.argmin(np.abs(ts - t)))] for t in times]
+    vmax = max(float(np.hypot(a["fluid"].get("u"), a["fluid"].get("v")).max()) for _, a in picks) or 1.0
+    fig, axes = plt.subplots(1, len(picks), figsize=(3.2 * len(picks), 2.8), squeeze=False)
+    for ax, (t, arrays) in zip(axes[0], picks):
+        f = arrays["fluid"]
+        x, y = np.asarray(f.get("x")), np.asarray(f.get("y"))
+        speed = np.hypot(f.get("u"), f.get("v"))
+        sc = ax.scatter(x, y, c=speed, s=1.0, cmap="jet", vmin=0.0, vmax=vmax, linewidths=0)
+        if walls and "wall" in arrays:
+            ax.scatter(arrays["wall"].get("x"), arrays["wall"].get("y"), c="0.6", s=0.5, linewidths=0)
+        ax.set_aspect("equal")
+        ax.set_xlim(-0.1, TANK_W + 0.1)
+        ax.set_ylim(-0.1, 3.1)
+        ax.set_title(f"t = {t:.2f} s")
+        ax.set_xticks([])
+        ax.set_yticks([])
+    fig.colorbar(sc, ax=list(axes[0]), label="|v| (m/s)", shrink=0.8)
+    path = path or os.path.join(outdir, "thesis_fig_1_2.png")
+    fig.savefig(path, dpi=150, bbox_inches="tight")
+    plt.close(fig)
+    return path

@@ -14,7 +14,10 @@ Time step (eqs. 23, 25), :class:`SHTCIntegrator`:
 #. stage3: A* = A (I - dt/2 L)(I + dt/2 L)^-1 (Cayley), RK4 relaxation of A* over dt if
    tau < infinity (eq. 25d), drift x += dt/2 v; neighbour update;
 #. evaluation 1: rho, lambda, H, then p and T; then the force;
-#. kick v += dt/2 a (stage4).
+#. kick v += dt/2 a (stage1 again).
+
+``integrator`` names another kick-drift sequence of :mod:`sphgen.splitting` (symplectic Euler,
+Ruth's third order, Yoshida's fourth order composition) with this drift and kick.
 
 Evaluation 2 runs once before the first step: the masses (``masses='kernel'``: m = rho0 /
 sum_b w_ab, the paper's sec. 3.1; ``'lattice'``: the masses given), then the constants C_rho
@@ -32,7 +35,8 @@ import numpy as np
 
 from sphgen.equation import Group, helper
 from sphgen.errors import InputError
-from sphgen.integrators import Integrator, IntegratorStep
+from sphgen.integrators import IntegratorStep
+from sphgen.splitting import INTEGRATORS, Splitting, Verlet
 from sphgen.kernels import get_kernel
 from sphgen.scheme import Bound, Scheme
 
@@ -71,6 +75,9 @@ def viscosity_factor(dt_over_tau):
     return 6.0 * dt_over_tau * r / (1.0 - r)
 
 
+SHTC_INTEGRATORS = tuple(n for n in INTEGRATORS if n != "viscous_verlet")
+"""The kick-drift sequences of sphgen.splitting the scheme takes (``integrator``)."""
+
 THETA_DETPOW = 5.0 / 3.0
 """theta = tau cs^2/3 |det A|^(-5/3) (paper footnote 1; thesis eq. 2.11)."""
 
@@ -101,7 +108,7 @@ class SHTCStep(IntegratorStep):
         self.rate, self.detpow = float(rate), float(detpow)
 
     def stage1(self, d_idx, d_u, d_v, d_w, d_au, d_av, d_aw, dt):
-        """Kick v += dt/2 a (eq. 25a)."""
+        """Kick v += dt/2 a (eqs. 25a, f)."""
         if self.move:
             add_scaled(d_idx, self.dim, 0.5 * dt, d_u, d_v, d_w, d_au, d_av, d_aw)
 
@@ -126,36 +133,41 @@ class SHTCStep(IntegratorStep):
         if self.move:
             add_scaled(d_idx, self.dim, 0.5 * dt, d_x, d_y, d_z, d_u, d_v, d_w)
 
-    def stage4(self, d_idx, d_u, d_v, d_w, d_au, d_av, d_aw, dt):
-        """Kick v += dt/2 a (eq. 25f)."""
-        if self.move:
-            add_scaled(d_idx, self.dim, 0.5 * dt, d_u, d_v, d_w, d_au, d_av, d_aw)
 
-
-class SHTCIntegrator(Integrator):
+class SHTCIntegrator(Splitting):
     """Verlet for (x, v), the mid-point (Cayley) rule for A and RK4 relaxation (Kincl et al.
     (2023), eqs. 23 and 25), with two neighbour-list builds per step as in the paper.
 
-    Equation sets: 0 = L at the half step, 1 = state and force at the full step, 2 = the
-    start-up (masses, C_rho, C_lambda), run once before evaluation 1 at t = 0.
+    A splitting (:mod:`sphgen.splitting`) whose drift over tau is stage2 (x += tau/2 v),
+    evaluation 0 (L at the half drift), stage3 (A over tau, x += tau/2 v) and whose kick over
+    tau is stage1 with 2 tau; ``sequence`` (default: Verlet, the paper's eq. 25) may be any of
+    ``sphgen.splitting.INTEGRATORS`` but the viscous Verlet (the relaxation is already the
+    dissipative step between the half drifts).  Equation sets: 0 = L at the half drift, 1 =
+    state and force, 2 = the start-up (masses, C_rho, C_lambda), run once before evaluation 1
+    at t = 0.
     """
 
     n_evaluations = 3
-    position_time = {"stage1": 0.0, "stage2": 0.5, "stage3": 1.0, "stage4": 1.0}
+    force_set = 1
+    sequence = Verlet.sequence
 
     def initial_accelerations(self, t, dt):
         self.compute_accelerations(2, t, dt)
-        self.compute_accelerations(1, t, dt)
+        super().initial_accelerations(t, dt)
 
-    def one_timestep(self, t, dt):
-        self.stage("stage1", t, dt)
-        self.stage("stage2", t, dt)
-        self.update_nnps()
-        self.compute_accelerations(0, t + 0.5 * dt, dt)
-        self.stage("stage3", t, dt)
-        self.update_nnps()
-        self.compute_accelerations(1, t + dt, dt)
-        self.stage("stage4", t + dt, dt)
+    def kick(self, tau):
+        self.forces()
+        self.run_stage("stage1", 2.0 * tau, self._t)
+
+    def drift(self, tau):
+        t0 = self._t
+        self.run_stage("stage2", tau, t0 + 0.5 * tau)
+        self.positions_moved()
+        self._t = t0 + 0.5 * tau
+        self.evaluate(0)
+        self._t = t0 + tau
+        self.run_stage("stage3", tau, self._t)
+        self.positions_moved()
 
 
 def identity_tensors(n):
@@ -185,7 +197,12 @@ class SHTCScheme(Scheme):
 
     def __init__(self, bodies, dim, rho0, c0, cs, h, dr, tau=math.inf, model="dprz", cp=0.0,
                  walls=(), moving_walls=(), cfl=0.05, masses="kernel", theta_det=False,
-                 kernel="wendland", motions=None, wall_velocity="prescribed"):
+                 kernel="wendland", motions=None, wall_velocity="prescribed", integrator="verlet"):
+        if integrator not in SHTC_INTEGRATORS:
+            raise InputError(f"SHTCScheme: integrator must be one of {', '.join(SHTC_INTEGRATORS)}, got "
+                             f"{integrator!r} (no viscous_verlet: the relaxation is already the dissipative "
+                             "step between the half drifts of eq. 25)")
+        self.integrator = integrator
         if wall_velocity not in WALL_VELOCITIES:
             raise InputError(f"SHTCScheme: wall_velocity must be one of {', '.join(WALL_VELOCITIES)}, "
                              f"got {wall_velocity!r}")
@@ -305,7 +322,7 @@ class SHTCScheme(Scheme):
         steps = {b: SHTCStep(self.dim, model, self.relaxation_rate, detpow, move=True) for b in self.bodies}
         steps.update({w: SHTCStep(self.dim, model, self.relaxation_rate, detpow, move=False)
                       for w in self.walls})
-        integrator = SHTCIntegrator(**steps)
+        integrator = SHTCIntegrator(INTEGRATORS[self.integrator].sequence, **steps)
         for array, motion in self.motions.items():
             integrator.add_motion(array, motion)
         return integrator

@@ -34,6 +34,13 @@ from ..equations.wcsph import (BodyForce, ContinuityEquation, DensityDiffusion,
                                TaitEOS)
 
 
+def tait_internal_energy(rho, rho0, B, gamma=7.0):
+    """Specific internal energy of the Tait fluid, the integral of p/rho^2 from rho0 (numpy):
+    e = B/((gamma - 1) rho0) ((rho/rho0)^(gamma-1) - 1) + B (1/rho - 1/rho0)."""
+    r = rho / rho0
+    return B / ((gamma - 1.0) * rho0) * (r ** (gamma - 1.0) - 1.0) + B * (1.0 / rho - 1.0 / rho0)
+
+
 class WCSPHStep(IntegratorStep):
     """Predictor-corrector (midpoint) stages for x, u and rho.
 
@@ -252,8 +259,5 @@ class WCSPHScheme(Scheme):
             pos = [pa.data.get(c, 0.0) for c in ("x", "y", "z")[:self.dim]]
             ke += 0.5 * float(np.sum(m * sum(c * c for c in vel)))
             pe -= float(np.sum(m * sum(gi * xi for gi, xi in zip(g, pos))))
-            r = rho / self.rho0
-            e = (self.B / ((self.gamma - 1.0) * self.rho0) * (r ** (self.gamma - 1.0) - 1.0)
-                 + self.B * (1.0 / rho - 1.0 / self.rho0))
-            ie += float(np.sum(m * e))
+            ie += float(np.sum(m * tait_internal_energy(rho, self.rho0, self.B, self.gamma)))
         return {"kinetic": ke, "potential": pe, "internal": ie, "total": ke + pe + ie}

@@ -41,3 +41,12 @@ def tmp_cache(tmp_path, monkeypatch):
     d = tmp_path / "cache"
     monkeypatch.setenv("SPHGEN_CACHE", str(d))
     return d
+
+
+def march(integ, dt, steps, t=0.0):
+    """The integrator's start-up evaluations, then ``steps`` steps of ``dt`` from ``t``; the end time."""
+    integ.initial_accelerations(t, dt)
+    for _ in range(steps):
+        integ.one_timestep(t, dt)
+        t += dt
+    return t

@@ -48,7 +48,7 @@ def test_dam_break_fronts():
 
 def test_every_file_names_its_source():
     files = sorted(glob.glob(os.path.join(reference.DATA_DIR, "*.csv")))
-    assert len(files) == 6
+    assert len(files) == 8
     for f in files:
         text = reference.source(os.path.basename(f))
         assert "Source:" in text and "How obtained:" in text and "doi:" in text

@@ -9,7 +9,7 @@ from sphgen.applications.shtc_kernel_convergence import convergence_study
 HS = (0.016, 0.022, 0.032, 0.045)
 
 
-@pytest.mark.parametrize("kernel", ["wendland", "quintic"])
+@pytest.mark.parametrize("kernel", ["wendland", "quintic", "gaussian", "quartic"])
 def test_interpolation_error_converges_as_h_squared(kernel):
     """Slope 2 +- 0.2 (the digest's proposal), under Theorem 1's bound, and the error tends to
     its Taylor term (C/d) h^2 max|lap f|, on a lattice whose quadrature error is negligible."""
@@ -31,9 +31,10 @@ def test_application_writes_results_and_plot(tmp_path):
     load_application("shtc_kernel_convergence")().run(["-d", str(out), "--n", "256", "--h", "0.032", "0.045",
                                                        "0.064", "0.09"])
     res = json.load(open(out / "results.json"))
-    assert set(res["kernels"]) == {"wendland", "quintic"}
+    assert set(res["kernels"]) == {"wendland", "quintic", "gaussian", "quartic"}
     assert abs(res["kernels"]["wendland"]["slope"] - 2.0) <= 0.2
     assert (out / "convergence.png").stat().st_size > 0
+    assert json.load(open(out / "info.json"))["completed"] is True      # automan's "finished"
 
 
 def test_too_coarse_a_lattice_is_refused(tmp_path):

@@ -61,3 +61,17 @@ def martin_moyce_1952(a_inch=2.25):
                          f"not {a_inch!r}")
     d = read_csv(f"martin_moyce_1952_dam_break_front_a{a_inch:g}in.csv")
     return d["T"], d["Z"]
+
+
+def violeau_2012_dam_break_front():
+    """Violeau (2012) SPH dam-break toe, Kincl's digitisation (the "VIO" curve of Kincl's thesis,
+    2023, Fig. 1.3): (T = t sqrt(2g/L), Z = x_front/L)."""
+    d = read_csv("violeau_2012_dam_break_front.csv")
+    return d["T"], d["Z"]
+
+
+def koshizuka_oka_1996_kincl():
+    """Koshizuka & Oka (1996) dam-break toe, experiment, Kincl's digitisation (the "EXP" points
+    of Kincl's thesis, 2023, Fig. 1.3): (T = t sqrt(2g/L), Z = x_front/L)."""
+    d = read_csv("koshizuka_oka_1996_dam_break_front_kincl.csv")
+    return d["T"], d["Z"]
