@@ -150,10 +150,7 @@ class SHTCIntegrator(Splitting):
     n_evaluations = 3
     force_set = 1
     sequence = Verlet.sequence
-
-    def initial_accelerations(self, t, dt):
-        self.compute_accelerations(2, t, dt)
-        super().initial_accelerations(t, dt)
+    startup_sets = (2,)
 
     def kick(self, tau):
         self.forces()

@@ -11,8 +11,9 @@ the method of its dam break (§1.6, the "SYM" curve of Fig. 1.3).
   factor grad w_ab the print omits), :class:`~sphgen.equations.md_viscosity.MDViscosity`;
 * the viscous Verlet step (eq. 1.82, with the dt the print omits in the viscous update):
   kick dt/2 with the conservative force, drift dt/2, neighbour update, viscous update
-  v += dt a_visc at the half step, drift dt/2, neighbour update, force, kick dt/2.  With
-  nu = 0 the viscous update is absent from the generated code and the step is Verlet (1.78);
+  v += dt a_visc at the half step, drift dt/2, neighbour update, force, kick dt/2
+  (:class:`sphgen.splitting.ViscousVerlet`).  With nu = 0 the viscous update is absent from
+  the generated code and the step is Verlet (1.78);
 * dummy walls (§1.6): "identical to fluid particles, except their velocity and positions are
   fixed" -- they take part in every sum, carry their own summation density, constant and
   Tait pressure, and have v = 0 in the viscous sum (no slip); ceil(2h/dr) layers (eq. 1.83).
@@ -27,47 +28,26 @@ from sphgen.equation import Group
 from sphgen.errors import InputError
 from sphgen.kernels import get_kernel
 from sphgen.scheme import Bound, Scheme
+from sphgen.splitting import KickDriftStep, Verlet, ViscousVerlet
 
 from ..equations.basic import SummationDensityWithConstant
 from ..equations.md_viscosity import MDViscosity
 from ..equations.momentum import PressureGradient
 from ..equations.shtc_density import DensityConstant
 from ..equations.wcsph import BodyForce, TaitEOS
-from sphgen.integrators import IntegratorStep
-from .shtc import SHTCIntegrator, add_scaled
 from .wcsph import WCSPHScheme, tait_internal_energy
 
 
-class ViscousVerletStep(IntegratorStep):
-    """Per-particle stages of Kincl (2023), eq. 1.82 (Verlet, eq. 1.78, when ``viscous`` is 0)."""
+class ThesisViscousVerlet(ViscousVerlet):
+    """Kincl (2023), eq. 1.82 (:class:`sphgen.splitting.ViscousVerlet`) on this scheme's equation
+    sets: 0 = density and the viscous acceleration at the half step, 1 = state and force, 2 =
+    the density constants, run once before the first force evaluation.  Two neighbour-list
+    builds per step, as the thesis says; with nu = 0 the scheme passes Verlet's sequence
+    (eq. 1.78: one evaluation and one build per step)."""
 
-    switches = ("dim", "viscous")
-
-    def __init__(self, dim, viscous=True):
-        self.dim, self.viscous = int(dim), int(viscous)
-
-    def stage1(self, d_idx, d_u, d_v, d_w, d_au, d_av, d_aw, dt):
-        """v(k+1/2) = v(k) + dt/2 f(k)/m, and v(k+1) = v~ + dt/2 f(k+1)/m (the kicks of
-        SHTCIntegrator)."""
-        add_scaled(d_idx, self.dim, 0.5 * dt, d_u, d_v, d_w, d_au, d_av, d_aw)
-
-    def stage2(self, d_idx, d_x, d_y, d_z, d_u, d_v, d_w, dt):
-        """x(k+1/2) = x(k) + dt/2 v(k+1/2)."""
-        add_scaled(d_idx, self.dim, 0.5 * dt, d_x, d_y, d_z, d_u, d_v, d_w)
-
-    def stage3(self, d_idx, d_x, d_y, d_z, d_u, d_v, d_w, d_auv, d_avv, d_awv, dt):
-        """v~ = v(k+1/2) + dt f_visc/rho (at the half step); x(k+1) = x(k+1/2) + dt/2 v~."""
-        if self.viscous:
-            add_scaled(d_idx, self.dim, dt, d_u, d_v, d_w, d_auv, d_avv, d_awv)
-        add_scaled(d_idx, self.dim, 0.5 * dt, d_x, d_y, d_z, d_u, d_v, d_w)
-
-
-class ViscousVerlet(SHTCIntegrator):
-    """Kincl (2023), eq. 1.82: the sequence of the SHTC step (kick, half drift, neighbour
-    update, evaluation 0 = viscous acceleration at the half step, stage3 = viscous update and
-    half drift, neighbour update, evaluation 1 = force, kick), two neighbour-list builds per
-    step as the thesis says.  Evaluation 2 (the density constants) runs once before the first
-    step."""
+    n_evaluations = 3
+    force_set, dissipative_set = 1, 0
+    startup_sets = (2,)
 
 
 class SymplecticSPHScheme(Scheme):
@@ -104,7 +84,7 @@ class SymplecticSPHScheme(Scheme):
         for pa in arrays:
             if pa.name not in self.fluids + self.walls:
                 continue
-            for p in ("p", "crho", "pavg", "au", "av", "aw", "auv", "avv", "awv"):
+            for p in ("p", "crho", "pavg", "au", "av", "aw", "au_visc", "av_visc", "aw_visc"):
                 if not pa.has(p):
                     pa.add_property(p)
             for c in ("x", "y", "z", "u", "v", "w"):
@@ -126,8 +106,8 @@ class SymplecticSPHScheme(Scheme):
         return [viscous, [density, eos, Group(force)], start]
 
     def get_integrator(self):
-        step = ViscousVerletStep(self.dim, viscous=self.nu > 0)
-        return ViscousVerlet(**{f: step for f in self.fluids})
+        step = KickDriftStep(self.dim, viscous=self.nu > 0)
+        return ThesisViscousVerlet(None if self.nu > 0 else Verlet.sequence, **{f: step for f in self.fluids})
 
     def get_timestep(self):
         """dt = cfl h/c0 (cfl = 0.2: the authors' code's 0.1 times the support radius over c)."""

@@ -78,6 +78,7 @@ class Splitting(Integrator):
     n_evaluations = 1
     force_set = 0
     dissipative_set = 1
+    startup_sets = ()       # equation sets run once, before the first force evaluation
     kick_stage, drift_stage, dissipate_stage = "stage1", "stage2", "stage3"
 
     def __init__(self, sequence=None, **steppers):
@@ -135,6 +136,8 @@ class Splitting(Integrator):
     # ------------------------------------------------------------ Integrator
     def initial_accelerations(self, t, dt):
         self._t, self._dt = t, dt
+        for index in self.startup_sets:
+            self.compute_accelerations(index, t, dt)
         self.forces()
 
     def restarted(self, step, t):
