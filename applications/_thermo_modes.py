@@ -46,18 +46,24 @@ def rates(app, y, t):
     return np.concatenate([a[:, 0], a[:, 1], a[:, 2], pa.aF, pa.aH, pa.aJ, pa.aE])
 
 
+def central_jacobian(f, y0, rel=1e-7, floor=1e-3):
+    """The Jacobian of f at y0 by central differences, step rel x max(|y_i|, floor)."""
+    jac = np.empty((y0.size, y0.size))
+    for i in range(y0.size):
+        e = rel * max(abs(y0[i]), floor)
+        yp, ym = y0.copy(), y0.copy()
+        yp[i] += e
+        ym[i] -= e
+        jac[:, i] = (f(yp) - f(ym)) / (2 * e)
+    return jac
+
+
 def rate_jacobian(app, rel=1e-7):
     """The Jacobian of ``rates`` at the application's current state (central differences,
     step rel x max(|y_i|, 1e-3)); the state is restored afterwards."""
     pa, t = app.scene.by_name["body"], app.solver.t
     y0 = state_vector(pa).copy()
-    jac = np.empty((y0.size, y0.size))
-    for i in range(y0.size):
-        e = rel * max(abs(y0[i]), 1e-3)
-        yp, ym = y0.copy(), y0.copy()
-        yp[i] += e
-        ym[i] -= e
-        jac[:, i] = (rates(app, yp, t) - rates(app, ym, t)) / (2 * e)
+    jac = central_jacobian(lambda y: rates(app, y, t), y0, rel)
     rates(app, y0, t)
     return jac
 

@@ -6,7 +6,9 @@ checks of issue 12 on it, and the checkerboard indicator R[p].
 Variants (``--variant``): ``full`` is the paper's {p, F, H, J, E} scheme with D_J (eqs.
 54d, 66, 73), ``reduced`` the {p, F, H, E} scheme of its Fig. 16 (J = det F, no D_J),
 ``full-no-DJ`` the full scheme without D_J (an ablation), ``full-vol`` the full scheme
-with D_J acting on the mean stress and on J, F, H together (not the paper's; docs/thermo.md).
+with D_J acting on the mean stress and on J, F, H together (not the paper's; docs/thermo.md),
+``full-pJ`` the full scheme with D_J on the jump of the volumetric part of Sigma_J only (a
+diagnostic of round 10, docs/thermo.md: its dissipation has no sign).
 """
 import json
 import os
@@ -23,7 +25,8 @@ from ..schemes.thermo_upwind import ThermoUpwindScheme
 
 VARIANTS = {"full": dict(reduced=False, dissipation=True), "reduced": dict(reduced=True, dissipation=True),
             "full-no-DJ": dict(reduced=False, dissipation="p"),
-            "full-vol": dict(reduced=False, dissipation=True, dj="volumetric")}
+            "full-vol": dict(reduced=False, dissipation=True, dj="volumetric"),
+            "full-pJ": dict(reduced=False, dissipation=True, dj="pressure")}
 
 PAPER_CFL = 0.3     # alpha_CFL of eq. 78, the paper's
 
@@ -48,8 +51,8 @@ class ThermoSolid(Application):
         """The scheme's options; ``variant_help`` says why the default variant is the default."""
         group.add_argument("--variant", choices=tuple(VARIANTS), default=self.default_variant,
                            help=f"full {{p, F, H, J, E}} (the paper's), reduced {{p, F, H, E}} (J = det F), "
-                                f"full-no-DJ (D_J dropped) or full-vol (D_J on the mean stress, moving J, F, H "
-                                f"together); default %(default)s: {variant_help}")
+                                f"full-no-DJ (D_J dropped), full-vol (D_J on the mean stress, moving J, F, H "
+                                f"together) or full-pJ (D_J on the volumetric part of Sigma_J; a diagnostic); default %(default)s: {variant_help}")
         group.add_argument("--hdx", type=float, default=1.2, help="h / dx (default %(default)s)")
         group.add_argument("--kernel", choices=("wendland", "quintic"), default="wendland",
                            help="smoothing kernel (default %(default)s)")

@@ -27,8 +27,8 @@ from sphgen.linalg import det3, inv3
 
 from .large_strain import cross33, ddot33, dot3, matvec3, tmatvec3
 from .thermo_materials import (conjugate_stresses, energy_from_temperature, entropy_from_temperature,
-                               first_piola, temperature_from_energy, temperature_from_entropy,
-                               wave_speeds)
+                               first_piola, isochoric_conjugates, temperature_from_energy,
+                               temperature_from_entropy, wave_speeds)
 
 E_FORM, ETA_FORM = 0, 1
 
@@ -85,7 +85,9 @@ class ThermoState(Equation):
     ``reduced``: the {p, F, H, E} scheme, J = det F (no J equation).  ``SD`` is the stress
     the J dissipation jumps: Sigma_J (the paper's, eq. 66), or with ``volumetric`` the mean
     stress varsigma = (Sigma_F : F + 2 Sigma_H : H + 3 J Sigma_J) / (3 J) (= P : F / 3J, the
-    conjugate of an isotropic change of F, H, J together; docs/thermo.md).
+    conjugate of an isotropic change of F, H, J together; docs/thermo.md), or with
+    ``volumetric`` 2 the volumetric part of Sigma_J, Sigma_J minus d/dJ of the isochoric terms
+    (a diagnostic of docs/thermo.md, round 10: not an entropy conjugate).
     """
 
     switches = ("model", "form", "reduced", "volumetric")
@@ -119,8 +121,13 @@ class ThermoState(Equation):
         first_piola(F, H, SF, SH, sj, P)
         d_SJ[d_idx] = sj
         d_SD[d_idx] = sj
-        if self.volumetric:
+        if self.volumetric == 1:
             d_SD[d_idx] = (ddot33(SF, F) + 2.0 * ddot33(SH, H)) / (3.0 * J) + sj
+        elif self.volumetric == 2 and self.model != 2:
+            iso = isochoric_conjugates(F, H, J, d_mat[2], d_mat[3], SF, SH)
+            if self.model == 1:
+                iso = iso * theta / d_mat[7]
+            d_SD[d_idx] = sj - iso
         for k in range(9):
             d_P[9 * d_idx + k] = P[k]
         d_p[d_idx] = -ddot33(P, F) / (3.0 * J)

@@ -309,8 +309,10 @@ class ThermoUpwindScheme(Scheme):
     ``dt``: a fixed step instead of eq. 78 every step (it must respect eq. 78 at t = 0);
     ``dissipation`` False drops the upwinding (for tests), ``"p"`` keeps D_p but drops
     D_J (an ablation, docs/thermo.md); ``dj``: 'paper' (D_J on the jump of Sigma_J, moving
-    J only, eqs. 54d, 66) or 'volumetric' (on the jump of the mean stress, moving J, F and
-    H together so that J stays det F; docs/thermo.md).  Essential conditions: a body
+    J only, eqs. 54d, 66), 'volumetric' (on the jump of the mean stress, moving J, F and
+    H together so that J stays det F; docs/thermo.md) or 'pressure' (on the jump of the
+    volumetric part of Sigma_J, moving J only: a diagnostic whose pair dissipation has no
+    sign; docs/thermo.md, round 10).  Essential conditions: a body
     with a ``vfix`` property (3 flags per particle) gets its velocity components reset to
     ``vB`` (zero, or ``velocity(t, pa)``); one with ``tfix`` gets its temperature reset to
     ``thB`` (or ``temperature(t, pa)``).  ``add_load(body, f)`` adds a body force / heat
@@ -329,10 +331,10 @@ class ThermoUpwindScheme(Scheme):
             raise InputError(f"ThermoUpwindScheme: form {form!r} must be one of {', '.join(FORMS)}")
         if dissipation not in (True, False, "p"):
             raise InputError(f"ThermoUpwindScheme: dissipation {dissipation!r} must be True, False or 'p'")
-        if dj not in ("paper", "volumetric"):
-            raise InputError(f"ThermoUpwindScheme: dj {dj!r} must be 'paper' or 'volumetric'")
-        if dj == "volumetric" and reduced:
-            raise InputError("ThermoUpwindScheme: dj='volumetric' needs the J equation (reduced=False)")
+        if dj not in ("paper", "volumetric", "pressure"):
+            raise InputError(f"ThermoUpwindScheme: dj {dj!r} must be 'paper', 'volumetric' or 'pressure'")
+        if dj != "paper" and reduced:
+            raise InputError(f"ThermoUpwindScheme: dj={dj!r} needs the J equation (reduced=False)")
         if se not in ("zero", "matched"):
             raise InputError(f"ThermoUpwindScheme: se {se!r} must be 'zero' or 'matched'")
         if se == "matched" and form != "E":
@@ -353,6 +355,7 @@ class ThermoUpwindScheme(Scheme):
         self.projection, self.cfl = bool(projection), float(cfl)
         self.dissipation = 2 if dissipation == "p" else int(bool(dissipation))
         self.volumetric = int(dj == "volumetric")
+        self.sd_mode = {"paper": 0, "volumetric": 1, "pressure": 2}[dj]
         self.se = int(se == "matched")
         self.dt = None if dt is None else float(dt)
         self.adaptive_dt = (("dt_cfl",), self.cfl) if dt is None else None
@@ -441,7 +444,7 @@ class ThermoUpwindScheme(Scheme):
                                           volumetric=self.volumetric, se=self.se)], reference=True)]
             if self.projection:
                 rates.append(Group([AngularMomentumProjection(b, form=form)]))
-            vol = self.volumetric
+            vol = self.sd_mode
             state.append(Group([ThermoState(b, model=model, form=form, reduced=red, volumetric=vol)]))
             state_speeds.append(Group([ThermoState(b, model=model, form=form, reduced=red, volumetric=vol),
                                        WaveSpeeds(b, model=model, hmin=self.dx)]))

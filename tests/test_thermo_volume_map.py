@@ -28,18 +28,26 @@ def cof(F):
     return np.linalg.det(F)[..., None, None] * np.linalg.inv(F).transpose(0, 2, 1)
 
 
+def box_lattice(shape, dx):
+    """A box of shape[0] x shape[1] x shape[2] vertices spaced dx from the origin, with
+    cell-fraction volumes (halved on each face); at rest."""
+    axes = [np.arange(m) * dx for m in shape]
+    X = np.array(np.meshgrid(*axes, indexing="ij")).reshape(3, -1).T
+    pa = ParticleArray("body", x=X[:, 0], y=X[:, 1], z=X[:, 2])
+    V = np.full(len(X), dx ** 3)
+    for k in range(3):
+        V *= np.where((X[:, k] < 1e-9) | (X[:, k] > axes[k][-1] - 1e-9), 0.5, 1.0)
+    pa.add_property("V", data=V)
+    return pa
+
+
 def smooth_cube(n):
     """Unit cube, vertex lattice n^3 (cell-fraction volumes); phi = X + EPS (x^2 y, y^2 z, z^2 x),
     F = grad phi, H = cof F, J = det F; a smooth velocity with non-zero divergence; theta_R."""
     dx = 1.0 / (n - 1)
-    g = np.arange(n) * dx
-    X = np.array(np.meshgrid(g, g, g, indexing="ij")).reshape(3, -1).T
-    x, y, z = X.T
-    pa = ParticleArray("body", x=x, y=y, z=z)
-    V = np.full(len(X), dx ** 3)
-    for k in range(3):
-        V *= np.where((X[:, k] < 1e-9) | (X[:, k] > 1 - 1e-9), 0.5, 1.0)
-    pa.add_property("V", data=V)
+    pa = box_lattice((n, n, n), dx)
+    x, y, z = pa.x, pa.y, pa.z
+    X = np.stack([x, y, z], 1)
     F = np.tile(np.eye(3), (len(X), 1, 1))
     F[:, 0, 0] += 2 * EPS * x * y
     F[:, 0, 1] += EPS * x * x
@@ -172,3 +180,84 @@ def test_volumetric_D_J_keeps_the_ballistic_identity(form, jumps):
     pa.SJ[:] = sj
     assert heat < 0 and D > 0 and per_pair.min() >= 0.0
     assert abs(lhs - (heat - D)) < 1e-10 * (abs(heat) + D), (lhs, heat, D)
+
+
+# ---------------------------------------------------------------------------------------
+# dj="pressure" (variant full-pJ, a diagnostic of round 10, not the paper's): D_J on the jump
+# of the volumetric part of Sigma_J only
+
+
+def test_pressure_D_J_ignores_an_isochoric_shear_the_paper_s_does_not():
+    """A non-uniform simple shear F = I + g(X) e_1 (x) e_2 at rest (det F = J = 1, theta_R):
+    Sigma_J = -(2/3) zeta_R J^(-5/3) F : F varies with the shear, so the paper's D_J moves J;
+    the volumetric part kappa (J - 1) + c_v Gamma_0 (theta_R - theta) is 0 everywhere, so the
+    diagnostic's D_J does not."""
+    out = {}
+    for dj in ("paper", "pressure"):
+        pa, dx = smooth_cube(6)
+        x, y = pa.x, pa.y
+        F = np.tile(np.eye(3), (pa.n, 1, 1))
+        F[:, 0, 1] = 0.3 * np.sin(2.0 * x + y)
+        pa.F[:] = F.reshape(-1)
+        pa.H[:] = cof(F).reshape(-1)
+        pa.J[:] = 1.0
+        for c in "uvw":
+            pa.get(c)[:] = 0.0
+        s, sc, integ = build(pa, dx, backend="cython", jumps="raw", dj=dj)
+        integ.initial_accelerations(0.0, 1e-3)
+        sc.compute(0, 0.0, 1e-3)
+        out[dj] = (np.abs(pa.aJ).max(), np.abs(pa.SD).max(), np.ptp(pa.SJ))
+    m = MieGruneisen(**BASE)
+    assert out["paper"][2] > 1e-3 * m.mu                  # Sigma_J varies with the shear
+    assert out["paper"][0] > 1e-3                         # and the paper's D_J moves J [1/s]
+    assert out["pressure"][1] < 1e-9 * m.mu               # the volumetric part is 0
+    assert out["pressure"][0] < 1e-12 * out["paper"][0]
+
+
+# ---------------------------------------------------------------------------------------
+# Round 10: the rest state of the paper's full scheme is linearly unstable
+
+
+def rest_growth(shape, **kw):
+    """Largest real part of the eigenvalues of the linearised semi-discrete rates (v, F, H, J,
+    E of every particle) at rest (F = H = I, J = 1, theta_R, v = 0) on a box lattice with
+    dx = 0.1 m, in units of c_p / dx, and the top mode's share of F and H (scaled norms)."""
+    from sphgen.applications._thermo_modes import central_jacobian
+    dx = 0.1
+    pa = box_lattice(shape, dx)
+    s, sc, integ = build(pa, dx, backend="cython", jumps="raw", **kw)
+    integ.initial_accelerations(0.0, 1e-3)
+    cp = float(pa.cp[0])
+    names = ("u", "v", "w", "F", "H", "J", "E")
+    y0 = np.concatenate([pa.get(nm).copy() for nm in names])
+
+    def rates(y):
+        k = 0
+        for nm in names:
+            a = pa.get(nm)
+            a[:] = y[k:k + a.size]
+            k += a.size
+        integ.initial_accelerations(0.0, 1e-3)
+        sc.compute(0, 0.0, 1e-3)
+        acc = pa.tint.reshape(-1, 3) / pa.rho[:, None]
+        return np.concatenate([acc[:, 0], acc[:, 1], acc[:, 2], pa.aF, pa.aH, pa.aJ, pa.aE])
+
+    lam, vec = np.linalg.eig(central_jacobian(rates, y0, floor=1.0))
+    i = int(np.argmax(lam.real))
+    n = pa.n
+    w = np.abs(vec[:, i]) ** 2
+    w[:3 * n] /= cp ** 2                                  # velocities in units of c_p
+    w[-n:] /= s.material.kappa ** 2                       # E in units of the bulk modulus
+    return lam[i].real * dx / cp, w[3 * n:21 * n].sum() / w.sum()
+
+
+def test_paper_D_J_makes_the_rest_state_linearly_unstable_full_vol_does_not():
+    """On a 3 x 2 x 2 block at rest the paper's D_J (raw jumps, E-form) gives a real eigenvalue
+    of about +0.1 c_p/dx, a mode of F and H with J nearly held (Sigma_F(I) = mu I and
+    Sigma_J(I) = -mu: the rest state is not a minimum of the ballistic energy once J may leave
+    det F); with D_J moving J, F, H together (full-vol) the largest real part is the finite
+    differences' noise, as without D_J."""
+    paper, share = rest_growth((3, 2, 2))
+    assert paper > 0.05 and share > 0.9
+    vol, _ = rest_growth((3, 2, 2), dj="volumetric")
+    assert vol < 1e-6
