@@ -137,3 +137,14 @@ def test_module_hash_ignores_where_the_project_lives():
     assert a == module_hash(src.format("/tmp/ci_clone", 12))
     assert a != module_hash(src.format("/work/main", 13))
     assert a != module_hash(src.format("/work/main", 12).replace("return 1", "return 2"))
+
+
+def test_generated_modules_carry_no_debug_information(tmp_cache):
+    """Python's own CFLAGS add -g, which made gcc take 39 s instead of 6.5 s on SHTC's
+    Taylor-Couette module: the build turns it off (-g0), so the shared object has no
+    .debug_info section (docs/performance.md, "Compile time")."""
+    from sphgen.codegen.build import load_or_build
+    mod, seconds = load_or_build("def twice(double x):\n    return 2.0 * x\n")
+    assert mod.twice(1.5) == 3.0 and seconds > 0
+    with open(mod.__file__, "rb") as f:
+        assert b".debug_info" not in f.read()
