@@ -91,9 +91,10 @@ def test_extrapolated_ring_velocity_is_the_default():
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(reason="the profile error at one instant is noise-limited: 1.20 % at t = 10 on the code of "
-                   "2026-11-24 02:56, 4.09 % on the current code (the runs agree to round-off until t ~ 3 and then "
-                   "drift apart); 1.0-4.3 % over the outputs t >= 4 and the four half-axes in both (docs/shtc.md)",
+@pytest.mark.xfail(reason="at 10 across (a third of the paper's resolution) the profile error at one instant "
+                   "is particle noise: measured 1.20 % and 4.09 % at t = 10 in two runs that differ only by "
+                   "round-off, 1.0-4.3 % over the outputs t >= 4 on four half-axes; at the paper's 30 across "
+                   "it is 1.43 % (test_paper_case_profile_error_below_two_percent; docs/shtc.md)",
                    strict=False)
 def test_paper_re20_at_10_across_below_two_percent(tmp_path):
     """The paper's Re = 20 with eq. 26's step to t = 10 at dr = 1/10 (100 665 steps), extrapolated ring
