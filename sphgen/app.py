@@ -201,7 +201,8 @@ class Application:
         return Scene(arrays, self.scheme.get_equations(), steppers=integrator.steppers,
                      kernel=getattr(self.scheme, "kernel", None), dim=self.dim,
                      domain=self.create_domain(), outputs=outputs, backend=opts.backend,
-                     threads=1 if not opts.openmp else opts.threads, skin=opts.skin)
+                     threads=1 if not opts.openmp else opts.threads, skin=opts.skin,
+                     evaluated=integrator.evaluated_sets())
 
     def _solver(self, integrator, dt):
         opts = self.options
