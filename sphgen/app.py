@@ -2,7 +2,8 @@
 
 ``sphgen run NAME [options]`` imports ``sphgen.applications.NAME``, builds its
 Application and runs it; ``sphgen list`` names the applications.  Every run writes
-``info.json`` in its output folder (automan's notion of a finished case).
+``info.json`` in its output folder (automan's notion of a finished case: ``completed``, or
+``stopped`` by the blow-up guard).
 
 Everything a user can get wrong is checked before compiling and before any file is
 touched; a user mistake is one line on stderr and a non-zero exit (``--debug`` or
@@ -17,7 +18,7 @@ import sys
 import time
 
 from . import __version__, io, run_folder
-from .errors import InputError, SphgenError, debug_requested, one_line
+from .errors import BlowUpError, InputError, SphgenError, debug_requested, one_line
 from .scene import Scene
 from .solver import Solver
 
@@ -262,7 +263,7 @@ class Application:
             self.solver.run()
         except SphgenError as e:
             error = str(e)
-            self._write_progress(error=error)
+            self._write_progress(error=error, stopped=isinstance(e, BlowUpError))
             raise
         finally:
             if error is None:
@@ -281,15 +282,16 @@ class Application:
         """(text, dict) of :meth:`sphgen.timing.Timers.report` for the run so far."""
         return self.timers.report(self.solver.wall_time, self.solver.step, self.scene.threads)
 
-    def _write_progress(self, completed=False, error=None):
-        """info.json and history.json as they stand now (both atomic)."""
+    def _write_progress(self, completed=False, error=None, stopped=False):
+        """info.json and history.json as they stand now (both atomic); ``stopped``: the
+        blow-up guard ended the run (a Ctrl-C is not a stop)."""
         if self.history_columns is not None:
             io.write_json(os.path.join(self.outdir, "history.json"),
                           {"columns": list(self.history_columns), "rows": self.history, **self.history_meta()})
         if self.diag is not None:
             io.write_json(os.path.join(self.outdir, "diagnostics.json"),
                           {"columns": self.diag.columns(self.scene.arrays), "rows": self.diag.rows})
-        io.write_json(os.path.join(self.outdir, "info.json"), self._info(completed, error))
+        io.write_json(os.path.join(self.outdir, "info.json"), self._info(completed, error, stopped))
 
     def _signature(self, arrays):
         """What defines the scene: a restart must agree on all of it."""
@@ -327,12 +329,12 @@ class Application:
                         total += times * pairs * (loop_flops(npass, loop) if flops else 1)
         return int(round(total))
 
-    def _info(self, completed, error=None):
+    def _info(self, completed, error=None, stopped=False):
         s, sc, opts = self.solver, self.scene, self.options
         n = sum(pa.n for pa in sc.arrays)
         steps = max(s.step, 1)
         return {
-            "completed": completed, "error": error, "t": s.t, "steps": s.step, "dt": s.dt,
+            "completed": completed, "stopped": stopped, "error": error, "t": s.t, "steps": s.step, "dt": s.dt,
             "n_particles": n, "particles": {pa.name: pa.n for pa in sc.arrays},
             "wall_time": s.wall_time, "compile_time": sc.compile_time, "setup_time": sc.setup_time,
             "threads": s.tuner.most if s.tuner else sc.threads, "backend": sc.backend,
