@@ -10,6 +10,7 @@ touched; a user mistake is one line on stderr and a non-zero exit (``--debug`` o
 ``SPHGEN_DEBUG=1`` shows the traceback).  See docs/reliability.md.
 """
 import argparse
+import difflib
 import importlib
 import math
 import os
@@ -355,13 +356,22 @@ def list_applications():
     return sorted(m.name for m in pkgutil.iter_modules(apps.__path__) if not m.name.startswith("_"))
 
 
+def unknown_application(name):
+    """The one line for a name that is no application: the nearest names (difflib) and the count."""
+    names = list_applications()
+    near = [f"'{n}'" for n in difflib.get_close_matches(name, names, n=3)]
+    count = f"('sphgen list' names all {len(names)})"
+    if not near:
+        return f"no application '{name}' {count}"
+    either = " or ".join([", ".join(near[:-1]), near[-1]] if len(near) > 1 else near)
+    return f"no application '{name}'; did you mean {either}? {count}"
+
+
 def load_application(name):
-    try:
-        mod = importlib.import_module(f"sphgen.applications.{name}")
-    except ModuleNotFoundError as e:
-        if e.name == f"sphgen.applications.{name}":
-            raise SystemExit(f"sphgen: no application '{name}'; known: {', '.join(list_applications())}")
-        raise
+    """The Application class of ``sphgen.applications.NAME``; an unknown name is an InputError."""
+    if name not in list_applications():
+        raise InputError(unknown_application(name))
+    mod = importlib.import_module(f"sphgen.applications.{name}")
     classes = [v for v in vars(mod).values() if isinstance(v, type) and issubclass(v, Application)
                and v is not Application and v.__module__ == mod.__name__]
     if len(classes) != 1:
@@ -393,7 +403,12 @@ def main(argv=None):
     if argv[0] != "run" or len(argv) < 2:
         raise SystemExit(f"sphgen: unknown command {' '.join(argv)!r}; try 'sphgen run NAME', "
                          "'sphgen precision NAME', 'sphgen stress NAME' or 'sphgen list'")
-    load_application(argv[1])().run(argv[2:])
+    try:
+        app = load_application(argv[1])
+    except InputError as e:
+        print(f"sphgen: {one_line(e)}", file=sys.stderr)
+        raise SystemExit(e.exit_code) from None
+    app().run(argv[2:])
     return 0
 
 
