@@ -6,7 +6,7 @@ the wave speeds are held (they are frozen over a step, Algorithm 1).  The Jacobi
 central differences of the compiled rates (state update, then the rate equations with the
 angular-momentum projection if on).  Usage (one thread):
 
-    python -m sphgen.applications._thermo_modes thermo_disk --dx 1 --tf 7 --cfl 0.25 [app options]
+    python -m sphgen.applications._thermo_modes thermo_disk --dx 1 --tf 7 --cfl 0.25 --variant full [app options]
         [--alphas 0.25 0.3] [--without-projection]
 
 runs the application to --tf, then prints for each alpha_CFL the largest |1 + z + z^2/2|,

@@ -4,7 +4,8 @@ per-step time series (momenta, energies, entropy, budget, J and theta ranges, a 
 checks of issue 12 on it, and the checkerboard indicator R[p].
 
 Variants (``--variant``): ``full`` is the paper's {p, F, H, J, E} scheme with D_J (eqs.
-54d, 66, 73), ``reduced`` the {p, F, H, E} scheme of its Fig. 16 (J = det F, no D_J),
+54d, 66, 73), ``reduced`` the {p, F, H, E} scheme of its Fig. 16 (J = det F, no D_J;
+with ``--form eta`` the {p, F, H, eta} scheme, ours, not the paper's),
 ``full-no-DJ`` the full scheme without D_J (an ablation), ``full-vol`` the full scheme
 with D_J acting on the mean stress and on J, F, H together (not the paper's; docs/thermo.md),
 ``full-pJ`` the full scheme with D_J on the jump of the volumetric part of Sigma_J only (a
@@ -50,7 +51,8 @@ class ThermoSolid(Application):
     def add_scheme_options(self, group, variant_help):
         """The scheme's options; ``variant_help`` says why the default variant is the default."""
         group.add_argument("--variant", choices=tuple(VARIANTS), default=self.default_variant,
-                           help=f"full {{p, F, H, J, E}} (the paper's), reduced {{p, F, H, E}} (J = det F), "
+                           help=f"full {{p, F, H, J, E}} (the paper's), reduced {{p, F, H, E}} (J = det F; "
+                                f"with --form eta {{p, F, H, eta}}, ours), "
                                 f"full-no-DJ (D_J dropped), full-vol (D_J on the mean stress, moving J, F, H "
                                 f"together) or full-pJ (D_J on the volumetric part of Sigma_J; a diagnostic); default %(default)s: {variant_help}")
         group.add_argument("--hdx", type=float, default=1.2, help="h / dx (default %(default)s)")
@@ -87,8 +89,6 @@ class ThermoSolid(Application):
             raise InputError(f"--output-at times must be finite and >= 0, got {o.output_at}")
         if o.se == "matched" and o.form != "E":
             raise InputError("--SE matched belongs to the E-form (--form E)")
-        if o.variant == "reduced" and o.form != "E":
-            raise InputError("--variant reduced is an E-form scheme (--form E)")
 
     def _solver(self, integrator, dt):
         solver = super()._solver(integrator, dt)

@@ -38,12 +38,14 @@ from .tasks import SphgenProblem, Simulation, paper_and_quick
 
 THIRD = repr(1.0 / 3.0)
 SIXTH = repr(1.0 / 6.0)
-# per section: the levels (coarsest first) and end times; None = the application's own tf
+# per section: the levels (coarsest first) and end times; None = the application's own tf.
+# The paper preset's punch levels are the paper's dx = 1/10, 1/13, 1/16 (2728, 5488, 10268
+# particles on our lattice; the paper's 2500/5000/10000).
 CONFIG = {
     "paper": dict(mms_n=(20, 24, 32, 40), mms_cases=(("limited", "buffer"), ("raw", "buffer"),
                                                      ("limited", "surface"), ("raw", "surface")),
                   lblock_dx=("1", "0.5", THIRD, "0.2"), disk_dx=("0.5", "0.25", "0.2", SIXTH),
-                  punch_dx=("0.1", repr(1 / 12), "0.0625"), gripper_dx=("0.02", "0.01"),
+                  punch_dx=("0.1", repr(1 / 13), "0.0625"), gripper_dx=("0.02", "0.01"),
                   ball_dx=("0.01", "0.005"), tf={}),
     "quick": dict(mms_n=(20, 24, 28, 32), mms_cases=(("limited", "buffer"), ("raw", "buffer"),
                                                      ("limited", "surface"), ("raw", "surface")),

@@ -297,7 +297,9 @@ class ThermoRK2(Integrator):
 
 class ThermoUpwindScheme(Scheme):
     """Upwind TL-SPH for thermo-elasticity, Ghavamian et al. (2021): E-form {p, F, H, J, E}
-    (default), eta-form {p, F, H, J, eta}, or the reduced {p, F, H, E} (J = det F).
+    (default), eta-form {p, F, H, J, eta}, or with ``reduced`` the {p, F, H, E} scheme of
+    their Fig. 16 (J = det F, no J equation) or its eta-form {p, F, H, eta} (ours, not the
+    paper's: the same J = det F with the entropy equation 57; docs/thermo.md).
 
     ``bodies``: array names (3-D; each needs the reference volume ``V``; ``rho`` defaults to
     the material's; ``theta`` to theta_R; ``F``, ``H`` to I and ``J`` to 1; reference
@@ -344,8 +346,6 @@ class ThermoUpwindScheme(Scheme):
         for name, v in (("dx", dx), ("hdx", hdx), ("cfl", cfl), ("dt", 1.0 if dt is None else dt)):
             if not (np.isfinite(v) and v > 0):
                 raise InputError(f"ThermoUpwindScheme: {name}={v!r} must be a positive number")
-        if reduced and form != "E":
-            raise InputError("ThermoUpwindScheme: the reduced {p, F, H, E} scheme is an E-form")
         self.bodies = list(bodies)
         self.material = material
         self.dx, self.hdx, self.h = float(dx), float(hdx), float(hdx) * float(dx)

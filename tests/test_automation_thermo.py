@@ -9,6 +9,7 @@ import pytest
 from automation import thermo
 from automation.thermo import (BALL_TIMES, CONFIG, DISK_TIMES, GRIPPER_TIMES, LBLOCK_TIMES, PUNCH_TIMES,
                                all_cases, punch_middle)
+from sphgen.applications._thermo_solid import cylinder_lattice
 
 COLUMNS = ("t", "L_x", "L_y", "L_z", "A_x", "A_y", "A_z", "sum_V_abs_p", "kinetic", "internal", "total",
            "ballistic", "entropy", "W_ext", "Q_in", "E_Dir", "J_min", "theta_min", "theta_max", "probe_vx",
@@ -26,6 +27,11 @@ def test_case_lists_follow_the_presets():
     assert "--no-projection" in quick["lblock_ablation_noproj"][1]
     assert quick["punch_ablation_limited"][1][:4] == ["--dx", punch_middle(CONFIG["quick"]), "--jumps", "limited"]
     assert f"punch_reduced_E_dx{thermo._dx_label(punch_middle(CONFIG['paper']))}" in paper
+    # the punch at the paper's dx = 1/10, 1/13, 1/16; Figs. 16, 19 at 1/13 (the paper's 5000)
+    assert [float(d) for d in CONFIG["paper"]["punch_dx"]] == pytest.approx([1 / 10, 1 / 13, 1 / 16], rel=1e-15)
+    assert [cylinder_lattice(float(d), 1.0, 0.0, 1.0, 0.5)[0].size
+            for d in CONFIG["paper"]["punch_dx"]] == [2728, 5488, 10268]
+    assert "punch_reduced_E_dx0.07692" in paper and "punch_full_eta_dx0.0625" in paper
     assert sum(k.startswith("mms_") for k in paper) == 4 * 4
     # the quick preset's levels are the coarsest: never finer than the paper's finest
     for key in ("lblock_dx", "disk_dx", "punch_dx", "gripper_dx", "ball_dx"):

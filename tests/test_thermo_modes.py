@@ -21,10 +21,11 @@ def test_rk2_amplification_is_heuns():
 @pytest.fixture(scope="module")
 def small_disk(tmp_path_factory):
     """A disk of radius 2 at dx = 1 (24 particles), spun and heated for 0.05 s (7 steps), so
-    that no jump is zero (the limiter's minmod has a kink at a zero jump)."""
+    that no jump is zero (the limiter's minmod has a kink at a zero jump); the paper's full
+    scheme (the linearisation's unknowns include J; the disk's default is the reduced one)."""
     app = ThermoDisk()
     app.run(["-d", str(tmp_path_factory.mktemp("modes")), "--no-progress", "--disable-output", "--threads", "1",
-             "--dx", "1", "--radius", "2", "--tf", "0.05"])
+             "--dx", "1", "--radius", "2", "--tf", "0.05", "--variant", "full"])
     return app
 
 
