@@ -6,8 +6,8 @@
 ``shtc_quick``) regenerates one paper's figures;
 automan's own names work too: a problem's class name (``VariationalOrder``) or its output
 folder name (``ctvf_fig13_cavity``).  Simulations go to ``outputs/``, figures to
-``manuscript/figures/``.  Finished cases (``info.json`` with ``completed: true``) are not
-run again.
+``manuscript/figures/``.  Finished cases (``info.json`` with ``completed: true``) and cases
+the blow-up guard stopped (``stopped: true``) are not run again.
 """
 import sys
 

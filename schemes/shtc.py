@@ -152,6 +152,10 @@ class SHTCIntegrator(Splitting):
     sequence = Verlet.sequence
     startup_sets = (2,)
 
+    def evaluated_sets(self):
+        """Every drift evaluates set 0 (L at the half drift)."""
+        return super().evaluated_sets() | {0}
+
     def kick(self, tau):
         self.forces()
         self.run_stage("stage1", 2.0 * tau, self._t)

@@ -2,13 +2,15 @@
 
 ``sphgen run NAME [options]`` imports ``sphgen.applications.NAME``, builds its
 Application and runs it; ``sphgen list`` names the applications.  Every run writes
-``info.json`` in its output folder (automan's notion of a finished case).
+``info.json`` in its output folder (automan's notion of a finished case: ``completed``, or
+``stopped`` by the blow-up guard).
 
 Everything a user can get wrong is checked before compiling and before any file is
 touched; a user mistake is one line on stderr and a non-zero exit (``--debug`` or
 ``SPHGEN_DEBUG=1`` shows the traceback).  See docs/reliability.md.
 """
 import argparse
+import difflib
 import importlib
 import math
 import os
@@ -17,7 +19,7 @@ import sys
 import time
 
 from . import __version__, io, run_folder
-from .errors import InputError, SphgenError, debug_requested, one_line
+from .errors import BlowUpError, InputError, SphgenError, debug_requested, one_line
 from .scene import Scene
 from .solver import Solver
 
@@ -201,7 +203,8 @@ class Application:
         return Scene(arrays, self.scheme.get_equations(), steppers=integrator.steppers,
                      kernel=getattr(self.scheme, "kernel", None), dim=self.dim,
                      domain=self.create_domain(), outputs=outputs, backend=opts.backend,
-                     threads=1 if not opts.openmp else opts.threads, skin=opts.skin)
+                     threads=1 if not opts.openmp else opts.threads, skin=opts.skin,
+                     evaluated=integrator.evaluated_sets())
 
     def _solver(self, integrator, dt):
         opts = self.options
@@ -262,7 +265,7 @@ class Application:
             self.solver.run()
         except SphgenError as e:
             error = str(e)
-            self._write_progress(error=error)
+            self._write_progress(error=error, stopped=isinstance(e, BlowUpError))
             raise
         finally:
             if error is None:
@@ -281,15 +284,16 @@ class Application:
         """(text, dict) of :meth:`sphgen.timing.Timers.report` for the run so far."""
         return self.timers.report(self.solver.wall_time, self.solver.step, self.scene.threads)
 
-    def _write_progress(self, completed=False, error=None):
-        """info.json and history.json as they stand now (both atomic)."""
+    def _write_progress(self, completed=False, error=None, stopped=False):
+        """info.json and history.json as they stand now (both atomic); ``stopped``: the
+        blow-up guard ended the run (a Ctrl-C is not a stop)."""
         if self.history_columns is not None:
             io.write_json(os.path.join(self.outdir, "history.json"),
                           {"columns": list(self.history_columns), "rows": self.history, **self.history_meta()})
         if self.diag is not None:
             io.write_json(os.path.join(self.outdir, "diagnostics.json"),
                           {"columns": self.diag.columns(self.scene.arrays), "rows": self.diag.rows})
-        io.write_json(os.path.join(self.outdir, "info.json"), self._info(completed, error))
+        io.write_json(os.path.join(self.outdir, "info.json"), self._info(completed, error, stopped))
 
     def _signature(self, arrays):
         """What defines the scene: a restart must agree on all of it."""
@@ -327,12 +331,12 @@ class Application:
                         total += times * pairs * (loop_flops(npass, loop) if flops else 1)
         return int(round(total))
 
-    def _info(self, completed, error=None):
+    def _info(self, completed, error=None, stopped=False):
         s, sc, opts = self.solver, self.scene, self.options
         n = sum(pa.n for pa in sc.arrays)
         steps = max(s.step, 1)
         return {
-            "completed": completed, "error": error, "t": s.t, "steps": s.step, "dt": s.dt,
+            "completed": completed, "stopped": stopped, "error": error, "t": s.t, "steps": s.step, "dt": s.dt,
             "n_particles": n, "particles": {pa.name: pa.n for pa in sc.arrays},
             "wall_time": s.wall_time, "compile_time": sc.compile_time, "setup_time": sc.setup_time,
             "threads": s.tuner.most if s.tuner else sc.threads, "backend": sc.backend,
@@ -353,13 +357,22 @@ def list_applications():
     return sorted(m.name for m in pkgutil.iter_modules(apps.__path__) if not m.name.startswith("_"))
 
 
+def unknown_application(name):
+    """The one line for a name that is no application: the nearest names (difflib) and the count."""
+    names = list_applications()
+    near = [f"'{n}'" for n in difflib.get_close_matches(name, names, n=3)]
+    count = f"('sphgen list' names all {len(names)})"
+    if not near:
+        return f"no application '{name}' {count}"
+    either = " or ".join([", ".join(near[:-1]), near[-1]] if len(near) > 1 else near)
+    return f"no application '{name}'; did you mean {either}? {count}"
+
+
 def load_application(name):
-    try:
-        mod = importlib.import_module(f"sphgen.applications.{name}")
-    except ModuleNotFoundError as e:
-        if e.name == f"sphgen.applications.{name}":
-            raise SystemExit(f"sphgen: no application '{name}'; known: {', '.join(list_applications())}")
-        raise
+    """The Application class of ``sphgen.applications.NAME``; an unknown name is an InputError."""
+    if name not in list_applications():
+        raise InputError(unknown_application(name))
+    mod = importlib.import_module(f"sphgen.applications.{name}")
     classes = [v for v in vars(mod).values() if isinstance(v, type) and issubclass(v, Application)
                and v is not Application and v.__module__ == mod.__name__]
     if len(classes) != 1:
@@ -391,7 +404,12 @@ def main(argv=None):
     if argv[0] != "run" or len(argv) < 2:
         raise SystemExit(f"sphgen: unknown command {' '.join(argv)!r}; try 'sphgen run NAME', "
                          "'sphgen precision NAME', 'sphgen stress NAME' or 'sphgen list'")
-    load_application(argv[1])().run(argv[2:])
+    try:
+        app = load_application(argv[1])
+    except InputError as e:
+        print(f"sphgen: {one_line(e)}", file=sys.stderr)
+        raise SystemExit(e.exit_code) from None
+    app().run(argv[2:])
     return 0
 
 

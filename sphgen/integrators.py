@@ -83,6 +83,11 @@ class Integrator:
         self.one_timestep(t, dt)
         self.steps_taken += 1
 
+    def evaluated_sets(self):
+        """The equation sets ``one_timestep`` and ``initial_accelerations`` can ever run, or
+        ``None`` (every set); the scene generates nothing for the others."""
+        return None
+
     def attach(self, scene):
         self.scene = scene
         n = len(scene.plan.group_plans)

@@ -25,7 +25,7 @@ class Scene:
     """Everything one simulation computes, specialised and compiled once."""
 
     def __init__(self, arrays, equations, steppers=None, kernel=None, dim=2, domain=None,
-                 outputs=None, backend="cython", threads=None, skin=0.0):
+                 outputs=None, backend="cython", threads=None, skin=0.0, evaluated=None):
         if backend not in BACKENDS:
             raise ValueError(f"backend must be {' or '.join(map(repr, BACKENDS))}, got {backend!r}")
         self.arrays = list(arrays)
@@ -40,7 +40,8 @@ class Scene:
             if name not in self.by_name:
                 raise ValueError(f"integrator stepper for unknown array '{name}'")
         t0 = time.perf_counter()
-        self.plan = plan_scene(self.arrays, equations, self.steppers, self.kernel, dim, domain, outputs)
+        self.plan = plan_scene(self.arrays, equations, self.steppers, self.kernel, dim, domain, outputs,
+                               evaluated)
         for pa in self.arrays:
             for p in self.plan.allocation[pa.name]:
                 pa.allocate(p)
@@ -90,6 +91,9 @@ class Scene:
 
     def compute(self, index, t, dt):
         """Run evaluation ``index`` (any index if there is only one equation set)."""
+        if index in self.plan.dropped:
+            raise ValueError(f"equation set {index} was declared never evaluated (Scene(evaluated=...)); "
+                             "nothing was generated for it")
         rows = self.plan.group_plans
         row = rows[index] if len(rows) > 1 else rows[0]
         for gp in row:

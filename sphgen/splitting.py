@@ -134,6 +134,11 @@ class Splitting(Integrator):
         self.run_stage(self.dissipate_stage, tau, self._t)
 
     # ------------------------------------------------------------ Integrator
+    def evaluated_sets(self):
+        """The force set, the start-up sets and, if the sequence dissipates, the dissipative set."""
+        dissipates = any(op == "dissipate" for op, _ in self.sequence)
+        return {self.force_set, *self.startup_sets} | ({self.dissipative_set} if dissipates else set())
+
     def initial_accelerations(self, t, dt):
         self._t, self._dt = t, dt
         for index in self.startup_sets:

@@ -95,9 +95,9 @@ def _parser(what, description):
 
 def _parse(p, argv):
     known, rest = p.parse_known_args(argv)
-    from .app import list_applications
+    from .app import list_applications, unknown_application
     if known.name not in list_applications():
-        raise InputError(f"no application '{known.name}'; known: {', '.join(list_applications())}")
+        raise InputError(unknown_application(known.name))
     known.directory = known.directory or f"{known.name}_{p.prog.split()[1]}"
     return known, rest
 

@@ -24,7 +24,7 @@ def test_info_json_outputs_and_xdmf(tmp_path):
     for key in ("completed", "t", "steps", "n_particles", "wall_time", "compile_time", "threads",
                 "options", "time_per_particle_step", "neighbour_pairs_per_step"):
         assert key in info, key
-    assert info["completed"] is True and info["n_particles"] == 256
+    assert info["completed"] is True and info["stopped"] is False and info["n_particles"] == 256
     assert info["t"] == pytest.approx(0.02) and info["options"]["nx"] == 16
     files = io.output_files(out)
     assert len(files) == info["steps"] // 10 + 1 + (info["steps"] % 10 > 0)
@@ -75,6 +75,7 @@ def test_blow_up_stops_with_where_and_keeps_last_good_state(tmp_path):
         assert np.all(np.isfinite(arr)), name
     info = json.load(open(out / "info.json"))
     assert info["completed"] is False and "fluid" in info["error"] and "particle" in info["error"]
+    assert info["stopped"] is True     # the guard stopped it: automan counts the case done
 
 
 def test_non_finite_value_stops_at_once_naming_array_property_particle(tmp_path):

@@ -96,6 +96,7 @@ def test_nu_zero_removes_the_viscous_update():
     integ = s.get_integrator()
     assert integ.steppers["fluid"].viscous == 0
     assert integ.sequence == (("kick", 0.5), ("drift", 1.0), ("kick", 0.5))   # one build per step
+    assert integ.evaluated_sets() == {1, 2}      # set 0 (density + viscosity) is never generated
 
 
 def run_app(tmp_path, *args, output=False):

@@ -148,3 +148,28 @@ def test_generated_modules_carry_no_debug_information(tmp_cache):
     assert mod.twice(1.5) == 3.0 and seconds > 0
     with open(mod.__file__, "rb") as f:
         assert b".debug_info" not in f.read()
+
+
+@pytest.mark.parametrize("command", ["run", "stress", "precision"])
+def test_unknown_application_is_one_line_with_the_nearest_names(command, capsys):
+    import os
+    from sphgen.app import main
+    n_apps = len([f for f in os.listdir(os.path.join(os.path.dirname(__file__), "..", "applications"))
+                  if f.endswith(".py") and not f.startswith("_")])
+    with pytest.raises(SystemExit) as e:
+        main([command, "taylr_green"])
+    said = (capsys.readouterr().err + (e.value.code if isinstance(e.value.code, str) else "")).strip()
+    assert e.value.code not in (0, None)
+    assert said == (f"sphgen: no application 'taylr_green'; did you mean 'taylor_green' or 'taylor_couette'? "
+                    f"('sphgen list' names all {n_apps})"), said
+
+
+def test_unknown_application_counts_the_applications_there_are(monkeypatch):
+    from sphgen import app
+    from sphgen.errors import InputError
+    monkeypatch.setattr(app, "list_applications", lambda: ["cavity", "couette", "poiseuille"])
+    with pytest.raises(InputError) as e:
+        app.load_application("zzz")
+    assert str(e.value) == "no application 'zzz' ('sphgen list' names all 3)"
+    with pytest.raises(InputError, match=r"did you mean 'cavity'\? \('sphgen list' names all 3\)$"):
+        app.load_application("cavty")

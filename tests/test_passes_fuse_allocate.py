@@ -1,6 +1,8 @@
 """Passes ``fuse`` and ``allocate``: one neighbour pass per group and destination; memory."""
+import pytest
+
 from sphgen.codegen import passes
-from sphgen.codegen.plan import new_plan
+from sphgen.codegen.plan import SceneError, new_plan
 from sphgen.equation import Equation, Group
 from sphgen.equations.basic import SummationDensity
 from sphgen.kernels import QuinticSpline
@@ -52,3 +54,42 @@ def test_allocate_gives_memory_to_what_the_kept_scene_touches_only():
     assert plan.allocation["fluid"] - set(fluid.data) == {"n"}     # data, plus what Count writes
     assert "spare" not in plan.allocation["wall"] and "n" not in plan.allocation["wall"]
     assert notes[0] == f"fluid: {len(fluid.data) + 1} properties; not allocated: spare, w, z"
+
+
+def _two_sets(evaluated):
+    fluid = lattice_cloud(nx=3)
+    fluid.add_property("n")
+    shared = Group([SummationDensity("fluid", ["fluid"])])
+    only_0 = Group([Reset("fluid"), Count("fluid", ["fluid"])])
+    sets = [[only_0, shared], [shared]]
+    return new_plan([fluid], sets, None, QuinticSpline(2), 2, outputs={"fluid": ["n", "rho"]},
+                    evaluated=evaluated)
+
+
+def test_drop_unevaluated_empties_the_sets_the_integrator_never_runs():
+    plan = _two_sets(evaluated={1})
+    notes = passes.drop_unevaluated(plan)
+    assert notes == ["set 0: never evaluated by the integrator; nothing generated"]
+    assert plan.evaluations[0] == [] and plan.dropped == {0}
+    assert [type(ep.eq).__name__ for ep in plan.eqplans] == ["SummationDensity"]
+    passes.run(plan, passes.PASSES[1:])                          # n is an output nobody writes now
+    assert [p.label for p in plan.neighbour_passes()] == ["g0_fluid"]
+    assert "never evaluated by the integrator; nothing generated" in plan.describe()
+
+
+def test_drop_unevaluated_keeps_every_set_when_the_integrator_does_not_say():
+    for evaluated in (None, {0, 1}):
+        plan = _two_sets(evaluated)
+        assert passes.drop_unevaluated(plan) == [] and plan.dropped == set()
+        assert len(plan.eqplans) == 3
+
+
+def test_drop_unevaluated_refuses_a_set_the_scheme_did_not_give():
+    with pytest.raises(SceneError, match=r"set\(s\) \[2\], but the scheme gave 2 set\(s\)"):
+        passes.drop_unevaluated(_two_sets(evaluated={0, 2}))
+
+
+def test_a_group_shared_by_two_sets_is_planned_and_compiled_once():
+    plan = passes.run(_two_sets(None))
+    assert plan.group_plans[0][1] is plan.group_plans[1][0]
+    assert [p.label for p in plan.neighbour_passes()] == ["g0_fluid", "g1_fluid"]

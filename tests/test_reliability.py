@@ -166,7 +166,8 @@ def test_ctrl_c_writes_the_last_complete_step(tmp_path):
     assert e.value.code == 130
     last = io.output_files(tmp_path)[-1]
     assert io.load(last)["solver_data"]["step"] == 7   # the last complete step
-    assert json.load(open(tmp_path / "info.json"))["completed"] is False
+    info = json.load(open(tmp_path / "info.json"))
+    assert info["completed"] is False and info["stopped"] is False   # interrupted, not stopped by the guard
 
 
 class _TwoThreadScene:

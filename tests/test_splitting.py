@@ -106,3 +106,21 @@ def test_startup_sets_run_once_before_the_first_forces():
     integ.initial_accelerations(0.0, 0.01)
     integ.one_timestep(0.0, 0.01)
     assert calls == [1, 0, 0], calls
+
+
+@pytest.mark.parametrize("name, sets", [("verlet", {0}), ("ruth3", {0}), ("viscous_verlet", {0, 1})])
+def test_evaluated_sets_are_the_force_set_and_the_dissipative_set_if_the_step_dissipates(name, sets):
+    assert get_splitting(name, body=KickDriftStep(2)).evaluated_sets() == sets
+
+
+def test_a_set_the_integrator_never_evaluates_is_not_generated_and_cannot_be_run():
+    """Verlet with the viscous Verlet's two sets: the damping set is dropped from the plan."""
+    pa, integ, _ = oscillator("verlet")
+    sets = [[Group([Spring("body")])], [Group([Damping("body", gamma=0.5)])]]
+    sc = Scene([pa], sets, steppers=integ.steppers, dim=2, backend="python",
+               evaluated=integ.evaluated_sets())
+    assert sc.plan.dropped == {1}
+    assert [type(ep.eq).__name__ for ep in sc.plan.eqplans] == ["Spring"]
+    sc.compute(0, 0.0, 0.1)
+    with pytest.raises(ValueError, match="equation set 1 was declared never evaluated"):
+        sc.compute(1, 0.0, 0.1)

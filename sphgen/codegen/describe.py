@@ -31,6 +31,8 @@ def _evaluations(plan):
     lines = []
     for i, row in enumerate(plan.group_plans):
         lines.append(f"evaluation {i}:")
+        if i in plan.dropped:
+            lines.append("  never evaluated by the integrator; nothing generated")
         for gp in row:
             lines.append(f"  group {gp.index}{_flags(gp.group)}:")
             for dest, eps in gp.dests.items():

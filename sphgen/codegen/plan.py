@@ -206,6 +206,8 @@ class Plan:
     dim: int
     domain: object = None
     outputs: dict = field(default_factory=dict)
+    evaluated: object = None                          # set indices the integrator runs (None: all)
+    dropped: set = field(default_factory=set)         # sets it never runs (nothing generated)
     needed: set = field(default_factory=set)          # (array, prop) something needs
     group_plans: list = field(default_factory=list)   # per evaluation: [GroupPlan]
     allocation: dict = field(default_factory=dict)    # array -> {props given memory}
@@ -221,8 +223,10 @@ class Plan:
         return "double" if prop in pa.constants else pa.props[prop].dtype
 
     def neighbour_passes(self):
-        """Every neighbour pass, in the order the evaluations run them."""
-        return [p for row in self.group_plans for gp in row for p in gp.passes.values()]
+        """Every neighbour pass once, in the order the evaluations first run them (a group
+        shared by several sets is one group plan)."""
+        gps = dict.fromkeys(gp for row in self.group_plans for gp in row)
+        return [p for gp in gps for p in gp.passes.values()]
 
     def neighbour_lists(self):
         """(dest, source, reference) of every neighbour list a pass walks, in order."""
@@ -247,8 +251,9 @@ def normalise_evaluations(equations):
     raise SceneError("equations must be a list of Equations, of Groups, or a list of per-evaluation lists")
 
 
-def new_plan(arrays, equations, steppers, kernel, dim, domain=None, outputs=None):
-    """The plan of a scene before any pass: its groups, equations and steppers collected."""
+def new_plan(arrays, equations, steppers, kernel, dim, domain=None, outputs=None, evaluated=None):
+    """The plan of a scene before any pass: its groups, equations and steppers collected;
+    ``evaluated``: the equation sets the integrator runs (``None``: every one)."""
     by_name = {pa.name: pa for pa in arrays}
     if len(by_name) != len(arrays):
         raise SceneError("two particle arrays have the same name")
@@ -265,4 +270,4 @@ def new_plan(arrays, equations, steppers, kernel, dim, domain=None, outputs=None
         evaluations.append(row)
     stepper_plans = [StepperPlan(a, s, i) for i, (a, s) in enumerate(sorted((steppers or {}).items()))]
     return Plan(by_name, evaluations, list(eqplans.values()), stepper_plans, kernel, dim, domain,
-                dict(outputs or {}))
+                dict(outputs or {}), None if evaluated is None else set(evaluated))

@@ -17,12 +17,13 @@ from .check_races import check_races
 from .choose_pair_symbols import choose_pair_symbols
 from .collect_functions import collect_functions
 from .collect_helpers import collect_helpers
+from .drop_unevaluated import drop_unevaluated
 from .fuse import fuse
 from .prune import prune
 from .specialise import specialise
 from .type_arguments import type_arguments
 
-PASSES = (check_arrays, specialise, check_exist, prune, check_properties, fuse, check_races,
+PASSES = (drop_unevaluated, check_arrays, specialise, check_exist, prune, check_properties, fuse, check_races,
           allocate, choose_pair_symbols, assign_registers, collect_functions, type_arguments,
           collect_helpers)
 
@@ -40,6 +41,6 @@ def until(name):
     return PASSES[:names.index(name)]
 
 
-def plan_scene(arrays, equations, steppers, kernel, dim, domain=None, outputs=None):
+def plan_scene(arrays, equations, steppers, kernel, dim, domain=None, outputs=None, evaluated=None):
     """The finished plan of a scene: :func:`~sphgen.codegen.plan.new_plan`, then every pass."""
-    return run(new_plan(arrays, equations, steppers, kernel, dim, domain, outputs))
+    return run(new_plan(arrays, equations, steppers, kernel, dim, domain, outputs, evaluated))

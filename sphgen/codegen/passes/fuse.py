@@ -26,14 +26,16 @@ def group_plan(group, index, eqplans):
 
 
 def fuse(plan):
-    """One parallel loop per group and destination, in the order the groups run."""
-    notes, index = [], 0
+    """One parallel loop per group and destination, in the order the groups run; a group
+    that several equation sets share is planned (and compiled) once."""
+    notes, planned = [], {}
     plan.group_plans = []
     for evaluation in plan.evaluations:
         row = []
         for group, eqplans in evaluation:
-            row.append(group_plan(group, index, eqplans))
-            index += 1
+            if id(group) not in planned:
+                planned[id(group)] = group_plan(group, len(planned), eqplans)
+            row.append(planned[id(group)])
         plan.group_plans.append(row)
     for p in plan.neighbour_passes():
         srcs = ", ".join(loop.source for loop in p.sources) or "no neighbours"
