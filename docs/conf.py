@@ -31,9 +31,8 @@ def _document_this_checkout():
     install maps ``sphgen.schemes`` to the folder of the install's own checkout)."""
     sys.path.insert(0, _ROOT)
     import sphgen  # noqa: F401  (the checkout's, now first on sys.path)
-    for name, folder in (("equations", "equations"), ("schemes", "schemes"),
-                         ("applications", "applications")):
-        path = os.path.join(_ROOT, folder)
+    for name in ("equations", "schemes", "applications"):
+        path = os.path.join(_ROOT, name)
         spec = importlib.util.spec_from_file_location(
             f"sphgen.{name}", os.path.join(path, "__init__.py"),
             submodule_search_locations=[path])
