@@ -1,10 +1,10 @@
 """Dam break of da Silva & Giraldi (2024, section 6): variational (generalised midpoint) or
-explicit leapfrog time integration, :class:`~schemes.variational.VariationalScheme`.
+explicit leapfrog time integration, :class:`~sphgen.schemes.variational.VariationalScheme`.
 
 Printed set-up: tank 0.58 x 0.29 m, water column 0.145 x 0.29 m of 29 x 58 = 1682
 particles (dx = 0.005, m = 0.025 kg per metre of depth), rho0 = 1000, g = 9.8, Gaussian
 kernel cut at h = 0.072, eps = 0.001, dt = 1e-4 s, alpha = 0.5.  Not printed, options
-with these defaults (digest seed-004 section 3.6 / 6):
+with these defaults (the project's digest of the paper, sections 3.6 and 6):
 
 * ``--c0 23.841`` = 10 sqrt(2 g H) (A2); ``--av-a 1 --av-b 1`` (A3);
 * ``--D 5.684`` = 2 g H and ``--r0 0.005`` = dx of the wall force eq. 58, ``--wall-power 1``

@@ -21,7 +21,7 @@ import numpy as np
 from .tasks import SphgenProblem, Simulation
 
 SNAPSHOTS = (0.10, 0.25, 0.50, 1.00)
-"""Snapshot times of Figs. 2 and 3 (not printed in the paper; digest seed-004 section 6)."""
+"""Snapshot times of Figs. 2 and 3 (not printed in the paper; the project's digest of the paper, section 6)."""
 
 
 def _plt():

@@ -24,7 +24,7 @@ class PressureGradient(Equation):
     With ``bql`` the destination's local mean pressure p_avg,a is subtracted from p_a
     and p_b (Basa, Quinlan & Lastiwka 2009), which removes the tensile instability of
     negative absolute pressures; the pair force is then not exactly antisymmetric, so
-    linear momentum is conserved to round-off only with ``bql`` off (docs/schemes).
+    linear momentum is conserved to round-off only with ``bql`` off (docs/schemes.rst).
     Initialises the acceleration, so it comes first.
     """
 

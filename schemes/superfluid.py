@@ -7,9 +7,15 @@ the linear energy model: :mod:`sphgen.equations.superfluid_energy`.
 Time integration, the Verlet-type scheme of sec. 3.4 (:class:`SuperfluidVerlet`):
 
 0. (first step only) rates of v and v_s;
-1. kick v, v_s by dt/2;  2. drift x by dt/2;  3. rho (neighbour lists rebuilt);
-4. rate of s;  5. s by dt;  6. drift x by dt/2;  7. rho (rebuilt);
-8. rates of v and v_s;  9. kick v, v_s by dt/2.
+1. kick v, v_s by dt/2;
+2. drift x by dt/2;
+3. rho (neighbour lists rebuilt);
+4. rate of s;
+5. s by dt;
+6. drift x by dt/2;
+7. rho (rebuilt);
+8. rates of v and v_s;
+9. kick v, v_s by dt/2.
 
 Rates use the most recent values.  Solid particles (``ptype`` ADIABATIC or COOLER) are
 never kicked: they keep v = v_s = 0, so they do not move, and v_n = v_ns = 0 on them;

@@ -2,7 +2,7 @@
 discrete Euler-Lagrange scheme solved by fixed-point iteration, and the explicit leapfrog.
 
 :class:`VariationalMidpoint` (eqs. 37, 40-42, 63-65, Algorithm 1), in velocity form
-(digest seed-004 section 2.4): with q_k, v_{k-1,k} = (q_k - q_{k-1})/dt and rho_{k-1,k} known,
+(the project's digest of the paper, section 2.4): with q_k, v_{k-1,k} = (q_k - q_{k-1})/dt and rho_{k-1,k} known,
 
 * a_2 = A_int at xbar_old = (1-alpha) q_{k-1} + alpha q_k = q_k - (1-alpha) dt v_{k-1,k},
   velocity v_{k-1,k}, density rho_{k-1,k} (evaluation 0, once per step),
