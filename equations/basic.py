@@ -24,7 +24,8 @@ class Vorticity2D(Equation):
 
 
 class SummationDensityWithConstant(Equation):
-    """rho_a = C_a + sum_b m_b W_ab with a time-independent C_a (``crho``) fixed at t = 0 (Kincl 2023, eq. 1.14)."""
+    """rho_a = C_a + sum_b m_b W_ab with a time-independent C_a (``crho``) fixed at t = 0 (Kincl 2023,
+    eq. 1.14; Kincl, Peshkov, Pavelka & Klika (2023), eq. 4)."""
 
     def initialize(self, d_idx, d_rho, d_crho):
         d_rho[d_idx] = d_crho[d_idx]

@@ -2,6 +2,8 @@
 (Kincl, Peshkov, Pavelka & Klika (2023), sec. 3.1)."""
 from sphgen.equation import Equation
 
+from .basic import SummationDensityWithConstant  # noqa: F401  (eq. 4; re-exported)
+
 
 class KernelVolumeMass(Equation):
     """m_a = rho0 V_a with V_a = (sum_b w_ab)^-1 at t = 0 (Kincl et al. (2023), sec. 3.1)."""
@@ -28,13 +30,3 @@ class DensityConstant(Equation):
 
     def loop(self, d_idx, d_crho, s_idx, s_m, WIJ):
         d_crho[d_idx] -= s_m[s_idx] * WIJ
-
-
-class SummationDensityWithConstant(Equation):
-    """rho_a = sum_b m_b w_ab + C_rho,a (Kincl, Peshkov, Pavelka & Klika (2023), eq. 4)."""
-
-    def initialize(self, d_idx, d_rho, d_crho):
-        d_rho[d_idx] = d_crho[d_idx]
-
-    def loop(self, d_idx, d_rho, s_idx, s_m, WIJ):
-        d_rho[d_idx] += s_m[s_idx] * WIJ

@@ -380,6 +380,15 @@ def load_application(name):
     return classes[0]
 
 
+def _print_to_pipe(text):
+    """Print ``text``; a reader that closes the pipe early (``sphgen list | head``) is no error."""
+    try:
+        print(text, flush=True)
+    except BrokenPipeError:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())   # Python's own advice
+    return 0
+
+
 def main(argv=None):
     argv = sys.argv[1:] if argv is None else argv
     if not argv or argv[0] in ("-h", "--help"):
@@ -391,8 +400,7 @@ def main(argv=None):
               "  list            list the applications")
         return 0
     if argv[0] == "list":
-        print("\n".join(list_applications()))
-        return 0
+        return _print_to_pipe("\n".join(list_applications()))
     if argv[0] in ("precision", "stress"):
         from . import studies
         try:

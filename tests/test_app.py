@@ -2,6 +2,8 @@
 import json
 import os
 import re
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -153,3 +155,14 @@ def test_pair_count_follows_the_evaluations_the_integrator_ran(tmp_path):
     one = [_pairs_of_set(plate, k) for k in range(3)]
     assert one[2] > 0
     assert plate.neighbour_pairs_per_step() == round(one[0] + one[1] * (steps + 1) / steps + one[2] / steps)
+
+
+def test_sphgen_list_into_a_closed_pipe_is_no_traceback():
+    """``sphgen list | head -1``: the reader leaves early; sphgen exits 0 and prints nothing."""
+    p = subprocess.Popen([sys.executable, "-m", "sphgen", "list"], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE,
+                         cwd=os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    p.stdout.close()              # before the child has started writing
+    err = p.stderr.read().decode()
+    p.stderr.close()
+    assert p.wait() == 0 and err == ""
