@@ -169,9 +169,9 @@ class DamBreakVariational(Application):
         return {"integrator": o.integrator, "alpha": o.alpha, "tol": o.tol, "kernel": o.kernel,
                 "density": o.density, "L": L, "M": self.M, "E0": self.E0}
 
-    def _write_progress(self, completed=False, error=None):
+    def _write_progress(self, **state):
         """history.json and info.json (base class) and steps.json: one row per step."""
-        super()._write_progress(completed, error)
+        super()._write_progress(**state)
         io.write_json(os.path.join(self.outdir, "steps.json"),
                       {"columns": list(STEP_COLUMNS), "rows": self.steps,
                        "evaluations": getattr(self.solver.integrator, "evaluations", None)})

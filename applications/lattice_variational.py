@@ -125,8 +125,8 @@ class LatticeVariational(Application):
         meta["time_step"] = self.solver.dt if self.solver is not None else o.time_step
         return meta
 
-    def _write_progress(self, completed=False, error=None):
-        super()._write_progress(completed, error)
+    def _write_progress(self, **state):
+        super()._write_progress(**state)
         io.write_json(os.path.join(self.outdir, "steps.json"),
                       {"columns": list(STEP_COLUMNS), "rows": self.steps,
                        "evaluations": getattr(self.solver.integrator, "evaluations", None)})
