@@ -91,10 +91,9 @@ def state_text(run):
     return stopped_at(run) or "not run"
 
 
-def missing(run, what, name=None):
-    """Print that ``what`` of ``run`` is missing (no results.json: stopped or not run); None."""
-    print(f"note: {name or os.path.basename(os.path.normpath(_folder(run)))} {state_text(run)}: "
-          f"{what} missing (only a run that reaches its end writes results.json)")
+def missing(run, what, why="only a run that reaches its end writes results.json"):
+    """Print that ``what`` of ``run`` is missing (it stopped or did not run) and ``why``; None."""
+    print(f"note: {os.path.basename(os.path.normpath(_folder(run)))} {state_text(run)}: {what} missing ({why})")
     return None
 
 

@@ -8,16 +8,19 @@ import pytest
 from automation.ctvf_taylor_green import all_cases, case_name, figures, order
 
 
-def fake_run(folder, l1_final, umax_dev=0.0, completed=True):
+def fake_run(folder, l1_final, umax_dev=0.0, completed=True, stopped_at=None):
+    """A run folder; ``stopped_at``: the blow-up guard ended it there (history up to it)."""
     os.makedirs(folder)
     t = np.linspace(0.0, 2.0, 21)
+    t = t[t <= stopped_at] if stopped_at is not None else t
     uex = np.exp(-8 * np.pi ** 2 * t / 100)
     l1 = l1_final * np.sin(np.pi * t / 4) ** 2 / np.sin(np.pi / 2) ** 2
     rows = np.column_stack([t, uex * (1 + umax_dev), uex, l1])
     with open(os.path.join(folder, "history.json"), "w") as f:
         json.dump({"rows": rows.tolist()}, f)
     with open(os.path.join(folder, "info.json"), "w") as f:
-        json.dump({"completed": completed}, f)
+        json.dump({"completed": completed and stopped_at is None, "stopped": stopped_at is not None,
+                   "t": 2.0 if stopped_at is None else stopped_at}, f)
 
 
 def test_case_list_names_and_options():
@@ -50,6 +53,28 @@ def test_order_and_summary_from_partial_runs(tmp_path):
     for name in ("fig09_re1000_spst.png", "fig10_spst_corrections.png", "baselines.png", "summary.md",
                  "fig12_re1000_pressure.png"):
         assert os.path.getsize(tmp_path / "fig" / name) > 100
+
+
+def test_a_stopped_case_is_drawn_up_to_its_stop_and_its_orders_are_nan(tmp_path, figure_texts, capsys):
+    sim = tmp_path / "sim"
+    fake_run(sim / case_name(1000, "ctvf", "spst", 50), 0.04)
+    fake_run(sim / case_name(1000, "ctvf", "spst", 100), 0.01, stopped_at=0.85)
+    fake_run(sim / case_name(1000, "ctvf", "spst", 150), 0.0025)
+    fake_run(sim / case_name(1000, "edac", nx=50), 0.08, stopped_at=1.2)
+    s = figures(str(sim), str(tmp_path / "fig"))
+    stopped = case_name(1000, "ctvf", "spst", 100)
+    assert s["stopped"] == {stopped: 0.85, case_name(1000, "edac", nx=50): 1.2}
+    assert stopped not in s["missing"] and s["runs"][stopped]["stopped_at"] == 0.85
+    assert s["runs"][stopped]["t"] == pytest.approx(0.8)            # its history up to the stop
+    o = s["orders"]["re1000_spst"]
+    assert o["l1_final"] == {"50": 0.04, "100": None, "150": pytest.approx(0.0025)}
+    assert [p["p"] for p in o["order"]] == [None, None]              # both need the missing L1 at t = 2
+    assert "100 x 100 (stopped at t = 0.85)" in figure_texts["fig09_re1000_spst.png"]
+    assert "150 x 150 |" in figure_texts["fig09_re1000_spst.png"] + " |"
+    assert "EDAC (stopped at t = 1.2)" in figure_texts["baselines.png"]
+    md = (tmp_path / "fig" / "summary.md").read_text()
+    assert f"| {stopped} | NaN (stopped at t = 0.85) |" in md and "| re1000_spst | 50 -> 100 | NaN |" in md
+    assert f"note: {stopped} stopped at t = 0.85: its L1 at t = 2" in capsys.readouterr().out
 
 
 def test_cavity_void_figure_from_finished_runs(tmp_path):
@@ -120,3 +145,53 @@ def test_impact_quick_preset_end_to_end(tmp_path):
         assert r["t"] == pytest.approx(PRESETS["quick"]["impact"]["tf"]) and r["hole_width"] > 0
     assert "| ctvf_spst |" in (out / "summary.md").read_text()
 
+
+
+def _solid_history(folder, stopped_at, columns=12):
+    """history.json of a solid run the blow-up guard stopped at ``stopped_at`` (no results.json)."""
+    os.makedirs(folder)
+    t = np.linspace(0.0, stopped_at, 6)
+    rows = np.column_stack([t] + [1.0 + 0.1 * k * np.sin(t) for k in range(1, columns)])
+    with open(os.path.join(folder, "history.json"), "w") as f:
+        json.dump({"rows": rows.tolist(), "c0": 50.0}, f)
+    with open(os.path.join(folder, "info.json"), "w") as f:
+        json.dump({"completed": False, "stopped": True, "error": "speed above the limit", "t": stopped_at}, f)
+
+
+def _solid_particles(folder, prefix, arrays, times):
+    from sphgen import io
+    from sphgen.particles import ParticleArray
+    x, y = np.random.default_rng(1).uniform(0, 1, (2, 30))
+    for step, t in enumerate(times):
+        io.write(os.path.join(folder, f"{prefix}_{step:06d}.h5"),
+                 [ParticleArray(a, x=x, y=y, p=x * t) for a in arrays], {"t": t, "dt": 1e-7, "step": step})
+
+
+@pytest.mark.parametrize("section", ["plate", "table1", "fig21", "uniaxial", "rings", "impact"])
+def test_solid_figures_draw_stopped_runs_labelled(tmp_path, section, figure_texts, capsys):
+    """Every case of the section stopped by the guard: its curves and particles up to the stop,
+    labelled "stopped at t = ...", its results.json-only numbers None in the summary."""
+    from automation import ctvf_solids as cs
+    folder_name, app, cases, draw, figs = cs.SECTIONS[section]
+    cfg = cs.PRESETS["quick"][section]
+    sim = tmp_path / "sim"
+    for name, params in cases(cfg).items():
+        stop = 0.6 * params["tf"]
+        _solid_history(sim / name, stop)
+        arrays = {"rings": ("left", "right"), "impact": ("solid",)}.get(section)
+        if arrays:
+            _solid_particles(sim / name, app, arrays, (0.0, 0.3 * params["tf"], stop))
+    summary = draw(str(sim), str(tmp_path / "fig"), cfg)
+    assert set(summary) == set(cases(cfg))
+    for name, r in summary.items():
+        stop = 0.6 * cases(cfg)[name]["tf"]
+        assert r["stopped_at"] == pytest.approx(stop) and r["t"] is None
+        assert all(v is None for k, v in r.items() if k not in ("stopped_at", "vf", "period_paper"))
+    texts = " || ".join(figure_texts.values())
+    assert texts.count("(stopped at t = ") >= len(summary)
+    for md in ("table1.md", "summary.md"):
+        if md in figs:
+            table = (tmp_path / "fig" / md).read_text()
+            assert "(stopped at t = " in table and "n/a" in table
+    out = capsys.readouterr().out
+    assert all(f"note: {name} stopped at t = " in out for name in summary)
