@@ -98,12 +98,13 @@ def missing(run, what, why="only a run that reaches its end writes results.json"
 
 
 def read_results(run, what="its results"):
-    """The run's results.json, or None with a printed note (:func:`missing`) if it has none."""
+    """The run's results.json, or None if it has none: with a printed note (:func:`missing`)
+    if the run was started (it has an info.json: stopped, or failed), silently if never run."""
     try:
         with open(os.path.join(_folder(run), "results.json")) as f:
             return json.load(f)
     except (OSError, ValueError):
-        return missing(run, what)
+        return missing(run, what) if run_info(run) else None
 
 
 def pick(run, res, keys):
