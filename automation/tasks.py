@@ -86,6 +86,13 @@ def state_suffix(run):
     return f" ({at})" if at else ""
 
 
+def stopped_marks(runs):
+    """" (tag stopped at t = ...; ...)" for the stopped runs of {tag: run}, "" if none: the label
+    of a curve drawn from several runs (a convergence line)."""
+    marks = [f"{tag} {stopped_at(run)}" for tag, run in runs.items() if stopped_at(run)]
+    return f" ({'; '.join(marks)})" if marks else ""
+
+
 def state_text(run):
     """What an empty panel of ``run`` says: "stopped at t = ..." or "not run"."""
     return stopped_at(run) or "not run"
@@ -147,4 +154,4 @@ def paper_and_quick(base, name, doc, module, **attrs):
 
 
 __all__ = ["SphgenProblem", "SphgenTask", "Simulation", "missing", "paper_and_quick", "pick", "read_results",
-           "run_info", "run_state", "state_suffix", "state_text", "stopped_at"]
+           "run_info", "run_state", "state_suffix", "state_text", "stopped_at", "stopped_marks"]

@@ -18,7 +18,7 @@ import os
 
 import numpy as np
 
-from .tasks import SphgenProblem, Simulation, pick, run_info, run_state, state_suffix
+from .tasks import SphgenProblem, Simulation, pick, run_info, run_state, state_suffix, stopped_marks
 
 SNAPSHOTS = (0.10, 0.25, 0.50, 1.00)
 """Snapshot times of Figs. 2 and 3 (not printed in the paper; digest seed-004 section 6)."""
@@ -294,8 +294,8 @@ class VariationalOrder(SphgenProblem):
                        if run_state(c) == "stopped"}
             out["series"][f"{name}_{density}"] = {"error_max": _finite(e), "slopes": _finite(slopes),
                                                   "stopped_at": stopped}
-            marks = "; ".join(f"{k} stopped at t = {v:.4g}" for k, v in stopped.items())
-            ax.loglog(self.dts, e, "o-", label=f"{name}, {density} density" + (f" ({marks})" if marks else ""))
+            ax.loglog(self.dts, e, "o-", label=f"{name}, {density} density"
+                      + stopped_marks({f"dt{dt:g}": c for dt, c in zip(self.dts, runs)}))
             print(f"{name:9s} {density:10s} errors {' '.join(f'{v:.3e}' for v in e)}  "
                   f"slopes {' '.join(f'{s:.2f}' for s in slopes)}")
         d = np.array(self.dts)

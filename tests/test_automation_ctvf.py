@@ -195,3 +195,37 @@ def test_solid_figures_draw_stopped_runs_labelled(tmp_path, section, figure_text
             assert "(stopped at t = " in table and "n/a" in table
     out = capsys.readouterr().out
     assert all(f"note: {name} stopped at t = " in out for name in summary)
+
+
+def test_cavity_void_figure_with_a_stopped_run(tmp_path, figure_texts, capsys):
+    """The run without corrections stopped at t = 3.5: drawn at its last output, its disc None."""
+    from automation.ctvf_cavity import figure
+    from sphgen import io
+    from sphgen.particles import ParticleArray
+    x, y = np.random.default_rng(0).uniform(0, 1, (2, 400))
+    for name, t in (("nx20", 25.0), ("nx20_nocorr", 3.5)):
+        folder = tmp_path / "sim" / name
+        os.makedirs(folder)
+        io.write(str(folder / "cavity_000100.h5"), [ParticleArray("fluid", x=x, y=y, u=x, v=y)],
+                 {"t": t, "dt": 0.01, "step": 100})
+    with open(tmp_path / "sim" / "nx20" / "results.json", "w") as f:
+        json.dump({"t": 25.0, "largest_empty_disc_over_dx": 1.7}, f)
+    with open(tmp_path / "sim" / "nx20_nocorr" / "info.json", "w") as f:
+        json.dump({"completed": False, "stopped": True, "t": 3.5}, f)
+    out = figure(str(tmp_path / "sim"), str(tmp_path / "fig"), nx=20)
+    assert out["nx20_nocorr"] == {"t": None, "largest_empty_disc_over_dx": None, "stopped_at": 3.5}
+    assert out["nx20"] == {"t": 25.0, "largest_empty_disc_over_dx": 1.7}
+    texts = figure_texts["fig13_cavity_void.png"]
+    assert "without corrections (stopped at t = 3.5), t = 3.5" in texts and "largest empty disc 1.70 dx" in texts
+    assert "note: nx20_nocorr stopped at t = 3.5: its largest empty disc missing" in capsys.readouterr().out
+
+
+def test_edac_baseline_figures_with_a_stopped_run(tmp_path, figure_texts):
+    """automation/taylor_green.py: nx = 100 stopped at t = 0.9, drawn up to it and labelled."""
+    from automation.taylor_green import TaylorGreenEDAC
+    prob = TaylorGreenEDAC(str(tmp_path / "sim"), str(tmp_path / "fig"))
+    for case in prob.cases:
+        fake_run(case.input_path(), 0.01, stopped_at=0.9 if case.params["nx"] == 100 else None)
+    prob.run()
+    assert "nx = 100 (stopped at t = 0.9)" in figure_texts["tg_edac_decay.png"]
+    assert "nx = 50 |" in figure_texts["tg_edac_l1.png"] and "nx = 100 (stopped at t = 0.9)" in figure_texts["tg_edac_l1.png"]
