@@ -228,4 +228,5 @@ def test_edac_baseline_figures_with_a_stopped_run(tmp_path, figure_texts):
         fake_run(case.input_path(), 0.01, stopped_at=0.9 if case.params["nx"] == 100 else None)
     prob.run()
     assert "nx = 100 (stopped at t = 0.9)" in figure_texts["tg_edac_decay.png"]
-    assert "nx = 50 |" in figure_texts["tg_edac_l1.png"] and "nx = 100 (stopped at t = 0.9)" in figure_texts["tg_edac_l1.png"]
+    l1 = figure_texts["tg_edac_l1.png"]
+    assert "nx = 50 |" in l1 and "nx = 100 (stopped at t = 0.9)" in l1
