@@ -32,7 +32,7 @@ import sys
 import numpy as np
 
 from .superfluid import _plt, _save
-from .tasks import SphgenProblem, Simulation, pick, read_results, run_state, state_suffix, state_text
+from .tasks import SphgenProblem, Simulation, pick, reached, read_results, run_state, state_suffix, state_text
 from .thermo import _dump, history
 
 # the cavity's snapshots ([P] Figs. 10-11, [T] Figs. 2.4-2.5): the captions give no times
@@ -141,6 +141,13 @@ def nearest(files, times):
         k = int(np.argmin(np.abs(have - t)))
         out[t] = (io.load(files[k][1])["arrays"], float(have[k]))
     return out
+
+
+def snapshots_upto_stop(folder, prefix, times):
+    """:func:`nearest` of the run's files, with None for the times a stopped run did not reach."""
+    files = outputs(folder, prefix)
+    return {t: hit if files and reached(folder, t, files[-1][0]) else None
+            for t, hit in nearest(files, times).items()}
 
 
 def _prop(pa, name):
@@ -338,11 +345,11 @@ def column_figures(sim_dir, out_dir, cfg):
     from sphgen.applications.twisting_column import H
     plt = _plt()
     run = os.path.join(sim_dir, "column")
-    shots = nearest(outputs(run, "twisting_column"), COLUMN_TIMES)
+    shots = snapshots_upto_stop(run, "twisting_column", COLUMN_TIMES)
     fig, axes = plt.subplots(1, len(COLUMN_TIMES), figsize=(2.6 * len(COLUMN_TIMES) + 1, 6))
     for ax, t in zip(axes, COLUMN_TIMES):
         if shots[t] is None:
-            _not_run(ax, f"t = {t:g} s")
+            _not_run(ax, f"t = {t:g} s", run)
             continue
         pa = shots[t][0]["column"]
         size = float(np.clip(12000.0 / max(pa.n, 1), 0.3, 20.0))
@@ -446,12 +453,12 @@ def _field(fig, ax, arrays, names, what, title, lim=None):
 def cavity_evolution(out_dir, name, folder, what, suptitle):
     """One field of the Re = 100 cavity at CAVITY_TIMES (one panel each)."""
     plt = _plt()
-    shots = nearest(outputs(folder, "shtc_cavity"), CAVITY_TIMES)
+    shots = snapshots_upto_stop(folder, "shtc_cavity", CAVITY_TIMES)
     fig, axes = plt.subplots(1, len(CAVITY_TIMES), figsize=(3.6 * len(CAVITY_TIMES), 3.4))
     shown = {}
     for ax, t in zip(axes, CAVITY_TIMES):
         if shots[t] is None:
-            _not_run(ax, f"t = {t:g}")
+            _not_run(ax, f"t = {t:g}", folder)
             continue
         shown[f"{t:g}"] = dict(t=shots[t][1], **_field(fig, ax, shots[t][0], ("fluid",), what,
                                                         f"t = {shots[t][1]:.4g}"))

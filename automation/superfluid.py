@@ -31,7 +31,7 @@ import numpy as np
 
 from sphgen.applications.second_sound import loglog_slope
 
-from .tasks import SphgenProblem, Simulation, read_results, state_suffix, stopped_marks
+from .tasks import SphgenProblem, Simulation, reached, read_results, state_suffix, state_text, stopped_marks
 
 CONFIG = {
     "paper": dict(N=(100, 200, 300), A=(0.01, 0.03, 0.05, 0.1), energy_N=200, Ms=(25, 50, 100),
@@ -230,8 +230,9 @@ def fig3_5(sim_dir, out_dir, cfg):
     return out
 
 
-def snapshots(folder, times):
-    """{time: output file} of the files nearest to each time (None if no file)."""
+def snapshots(folder, times, upto_stop=True):
+    """{time: (output file, its time)} of the files nearest to each time: None if no file or,
+    with ``upto_stop``, a time the run did not reach before the guard stopped it."""
     from sphgen import io
     try:
         files = io.output_files(folder, "fountain")
@@ -240,15 +241,16 @@ def snapshots(folder, times):
     if not files:
         return {t: None for t in times}
     have = np.array([io.read_solver_data(p)["t"] for p in files])
-    return {t: (files[int(np.argmin(np.abs(have - t)))], float(have[np.argmin(np.abs(have - t))])) for t in times}
+    return {t: (files[int(np.argmin(np.abs(have - t)))], float(have[np.argmin(np.abs(have - t))]))
+            if not upto_stop or reached(folder, t, have.max()) else None for t in times}
 
 
-def _field_panels(ax_list, shots, field, label, window, cmap):
+def _field_panels(ax_list, shots, field, label, window, cmap, run):
     from sphgen import io
     from sphgen.applications.fountain import MODEL
     for ax, (t, hit) in zip(ax_list, shots.items()):
         if hit is None:
-            ax.text(0.5, 0.5, "not run", ha="center", transform=ax.transAxes)
+            ax.text(0.5, 0.5, state_text(run), ha="center", transform=ax.transAxes)
             ax.set_title(f"t = {t * 1e3:g} ms", fontsize=8)
             continue
         path, t_file = hit
@@ -272,7 +274,8 @@ def fig3_6(sim_dir, out_dir):
     fig, axes = plt.subplots(1, 4, figsize=(15, 3.8))
     run = os.path.join(sim_dir, "fountain_start_W80")
     shots = snapshots(run, START_TIMES)
-    _field_panels(axes, shots, lambda pa, M: (pa.T - M.T0) * 1e3, "T - T0 [mK]", (-8.5, 8.5, -0.5, 17.5), "inferno")
+    _field_panels(axes, shots, lambda pa, M: (pa.T - M.T0) * 1e3, "T - T0 [mK]", (-8.5, 8.5, -0.5, 17.5), "inferno",
+                  run)
     fig.suptitle("Fig. 3.6: temperature in the cell, 80 W/m" + state_suffix(run))
     _save(fig, out_dir, "fig3_6")
 
@@ -285,8 +288,9 @@ def fig3_7(sim_dir, out_dir, cfg):
     fig, axes = plt.subplots(1, len(cfg["powers"]), figsize=(4 * len(cfg["powers"]), 6))
     for ax, W in zip(np.atleast_1d(axes), cfg["powers"]):
         run = os.path.join(sim_dir, f"fountain_W{W}")
-        shots = snapshots(run, (tf,))
-        _field_panels([ax], shots, lambda pa, M: np.hypot(pa.u, pa.v), "|v| [m/s]", (-25, 25, -10, 60), "viridis")
+        shots = snapshots(run, (tf,), upto_stop=False)            # a stopped run: its last state
+        _field_panels([ax], shots, lambda pa, M: np.hypot(pa.u, pa.v), "|v| [m/s]", (-25, 25, -10, 60), "viridis",
+                      run)
         ax.set_title(f"{W} W/m{state_suffix(run)}, " + ax.get_title(), fontsize=8)
     fig.suptitle("Fig. 3.7: |v| at the end")
     _save(fig, out_dir, "fig3_7")
@@ -301,7 +305,8 @@ def fig3_8(sim_dir, out_dir, cfg):
     fig, axes = plt.subplots(2, SNAPSHOTS // 2, figsize=(16, 9))
     run = os.path.join(sim_dir, "fountain_W80")
     shots = snapshots(run, times)
-    _field_panels(axes.ravel(), shots, lambda pa, M: (pa.T - M.T0) * 1e3, "T - T0 [mK]", (-25, 25, -10, 60), "inferno")
+    _field_panels(axes.ravel(), shots, lambda pa, M: (pa.T - M.T0) * 1e3, "T - T0 [mK]", (-25, 25, -10, 60), "inferno",
+                  run)
     fig.suptitle("Fig. 3.8: temperature and shape, 80 W/m" + state_suffix(run))
     _save(fig, out_dir, "fig3_8")
 

@@ -93,6 +93,13 @@ def stopped_marks(runs):
     return f" ({'; '.join(marks)})" if marks else ""
 
 
+def reached(run, t, last, tol=0.01):
+    """False for a time ``t`` that a stopped run did not reach (later than its last output
+    ``last`` by more than ``tol`` of it): its panel says "stopped at t = ..." instead of
+    repeating the last output."""
+    return run_state(run) != "stopped" or t <= last * (1 + tol) + 1e-12
+
+
 def state_text(run):
     """What an empty panel of ``run`` says: "stopped at t = ..." or "not run"."""
     return stopped_at(run) or "not run"
@@ -154,4 +161,4 @@ def paper_and_quick(base, name, doc, module, **attrs):
 
 
 __all__ = ["SphgenProblem", "SphgenTask", "Simulation", "missing", "paper_and_quick", "pick", "read_results",
-           "run_info", "run_state", "state_suffix", "state_text", "stopped_at", "stopped_marks"]
+           "reached", "run_info", "run_state", "state_suffix", "state_text", "stopped_at", "stopped_marks"]

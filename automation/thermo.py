@@ -38,7 +38,7 @@ import sys
 import numpy as np
 
 from .superfluid import _json, _plt, _save
-from .tasks import (SphgenProblem, Simulation, paper_and_quick, pick, read_results, run_info, run_state,
+from .tasks import (SphgenProblem, Simulation, paper_and_quick, pick, reached, read_results, run_info, run_state,
                     state_suffix, state_text, stopped_marks)
 
 THIRD = repr(1.0 / 3.0)
@@ -232,7 +232,7 @@ def snapshot_figure(out_dir, name, rows, suptitle, view=(25, -60)):
         for j, t in enumerate(times):
             ax = fig.add_subplot(len(rows), ncol, i * ncol + j + 1, projection="3d")
             hit = shots[t]
-            if hit is None or (run_state(folder) == "stopped" and hit[1] < t - 1e-9):
+            if hit is None or not reached(folder, t, hit[1]):
                 _not_run(ax, f"{label}, t = {t:g} s", folder)      # none, or after the stop
                 continue
             pa, t_file = hit

@@ -211,8 +211,9 @@ def test_stopped_runs_are_drawn_up_to_the_stop_and_labelled(tmp_path, figure_tex
     _fake_runs(sim, cfg)
     re400 = cavity_name(*cfg["cavity"][1][:2])
     for name, t in (("plate_cp10", 3e-5), ("couette", 10.0), (re400, 7.5), ("dam_break", 0.6),
-                    ("reversibility", 0.01)):
+                    ("reversibility", 0.01), ("column", 0.1)):
         _stop(str(sim / name), t)
+    os.remove(sim / "column" / "twisting_column_000002.h5")      # its file at t = 0.2: after the stop
     got = shtc.figures(str(sim), str(out), cfg)
     for name in FIGURES:
         assert os.path.getsize(out / name / f"{name}.png") > 0, name
@@ -220,7 +221,9 @@ def test_stopped_runs_are_drawn_up_to_the_stop_and_labelled(tmp_path, figure_tex
     assert "SHTC-SPH (sphgen) (stopped at t = 3e-05)" in figure_texts["P_fig2.png"]
     assert "c_p = 10 c0, t = 3e-05 s (stopped at t = 3e-05)" in figure_texts["P_fig4.png"]
     assert "stopped at t = 10" in figure_texts["P_fig8.png"] and "(stopped at t = 10)" in figure_texts["P_fig9.png"]
-    assert got["couette"] == {"stopped_at": 10.0}
+    assert got["couette"] == {"stopped_at": 10.0} and got["column"] == {"stopped_at": 0.1}
+    p5 = figure_texts["P_fig5.png"]        # 0.05 and 0.1 drawn; 0.15 and 0.2 after the stop
+    assert p5.count("| stopped at t = 0.1 |") == 2 and "t = 0.1 s" in p5 and "(stopped at t = 0.1)" in p5
     with open(out / "T_fig2_6" / "T_fig2_6.json") as f:
         centre = json.load(f)
     assert centre["Re400"]["stopped_at"] == 7.5 and centre["Re400"]["ghia_error"] is None
