@@ -31,7 +31,7 @@ import numpy as np
 
 from sphgen.tools.plots import particle_panels
 
-from .tasks import SphgenProblem, Simulation, paper_and_quick, pick, read_results, run_state, state_suffix
+from .tasks import SphgenProblem, Simulation, paper_and_quick, pick, reached, read_results, run_state, state_suffix
 
 VF = (0.001, 0.01, 0.03, 0.05)
 """V_f of Table 1 (Adepu & Ramachandran 2021)."""
@@ -118,7 +118,8 @@ def overlay(path, series, xlabel, ylabel, title, reference=None):
 
 
 def snapshots(folder, app, arrays, times, value="p"):
-    """[(t, x, y, value)] from the particle files nearest to ``times`` (of the arrays named)."""
+    """[(t, x, y, value)] from the particle files nearest to ``times`` (of the arrays named); the
+    times a stopped run did not reach are left out."""
     from sphgen import io
     try:
         files = io.output_files(folder, app)
@@ -129,7 +130,7 @@ def snapshots(folder, app, arrays, times, value="p"):
     loaded = [io.load(f) for f in files]
     ts = np.array([d["solver_data"]["t"] for d in loaded])
     out = []
-    for t in times:
+    for t in (t for t in times if reached(folder, t, ts.max())):
         d = loaded[int(np.argmin(np.abs(ts - t)))]
         pas = [d["arrays"][a] for a in arrays]
         out.append((float(d["solver_data"]["t"]), *(np.concatenate([getattr(pa, c) for pa in pas])

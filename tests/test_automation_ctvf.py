@@ -189,6 +189,10 @@ def test_solid_figures_draw_stopped_runs_labelled(tmp_path, section, figure_text
         assert all(v is None for k, v in r.items() if k not in ("stopped_at", "vf", "period_paper"))
     texts = " || ".join(figure_texts.values())
     assert texts.count("(stopped at t = ") >= len(summary)
+    if arrays:      # particle panels only at the times before the stop (0.6 tf)
+        reached = {"rings": 2, "impact": 3}[section]      # of tf * (0, 1/3, 2/3, 1), tf * (0, 1/4, 1/2, 1)
+        panels = [k for k in figure_texts if k.startswith(("fig24", "fig29"))]
+        assert panels and all(figure_texts[k].count("(stopped at t = ") == reached for k in panels)
     for md in ("table1.md", "summary.md"):
         if md in figs:
             table = (tmp_path / "fig" / md).read_text()
