@@ -18,7 +18,7 @@ import os
 
 import numpy as np
 
-from .tasks import SphgenProblem, Simulation, pick, run_info, run_state, state_suffix, stopped_marks
+from .tasks import SphgenProblem, Simulation, pick, run_info, run_state, state_suffix, stopped_at, stopped_marks
 
 SNAPSHOTS = (0.10, 0.25, 0.50, 1.00)
 """Snapshot times of Figs. 2 and 3 (not printed in the paper; digest seed-004 section 6)."""
@@ -62,14 +62,14 @@ class VariationalDamBreak(SphgenProblem):
         summary = {"snapshots": list(SNAPSHOTS)}
         for label, folder, fig in (("implicit", imp, "variational_fig2_implicit.png"),
                                    ("explicit", exp, "variational_fig3_explicit.png")):
-            # a stopped run has no files after its stop: those panels stay empty (count None)
             files = outputs_by_time(folder)
             f, axes = plt.subplots(2, 2, figsize=(9, 5.2), sharex=True, sharey=True)
             counts = []
             for ax, t in zip(axes.ravel(), SNAPSHOTS):
                 path = files.get(round(t, 9))
-                if path is None:
+                if path is None:               # a stopped run has no file after its stop
                     counts.append(None)
+                    ax.set_title(f"t = {t:.2f} s: {stopped_at(folder) or 'no output'}", fontsize=9)
                     continue
                 _, x, y = positions(path)
                 out = ejected(x, y)

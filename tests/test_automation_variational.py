@@ -105,7 +105,7 @@ def test_dam_break_figures_with_a_stopped_explicit_run(tmp_path, figure_texts, c
     assert s["ejected_explicit"][2:] == [None, None]          # 0.5 and 1.0 s: after the stop
     assert s["D"]["t_final"] == 0.4 and s["D"]["max_per_quarter_second"][2:] == [None, None]
     assert s["D"]["at_snapshots"][2:] == [None, None]
-    assert "stopped at t = 0.42" in figure_texts["variational_fig3_explicit.png"]
+    assert "t = 0.50 s: stopped at t = 0.42" in figure_texts["variational_fig3_explicit.png"]
     assert "stopped at t = 0.42" not in figure_texts["variational_fig2_implicit.png"]
     assert "explicit (stopped at t = 0.42)" in figure_texts["variational_fig5_Q.png"]
     assert "(stopped at t = 0.42)" in figure_texts["variational_fig4_D.png"]
