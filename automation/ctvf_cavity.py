@@ -4,8 +4,10 @@ Re = 100 at 150 x 150 to t = 25, with and without the correction terms
 (``outputs/ctvf_fig13_cavity/nx150``, ``nx150_nocorr``).  Figure ``fig13_cavity_void.png``:
 the particles of both runs at the end, coloured by speed, each titled with its largest
 empty disc (:func:`sphgen.tools.probes.largest_empty_disc`, in dx, from ``results.json``);
-``fig13.json`` holds the two numbers.  ``python -m automation.ctvf_cavity [outputs] [nx]``
-draws the same from finished runs of another resolution, without running anything.
+``fig13.json`` holds the two numbers.  A run the blow-up guard stopped is drawn at its last
+output, titled "stopped at t = ...", its empty disc None (only results.json has it).
+``python -m automation.ctvf_cavity [outputs] [nx]`` draws the same from finished runs of
+another resolution, without running anything.
 """
 import json
 import os
@@ -14,7 +16,7 @@ import sys
 import numpy as np
 
 from .ctvf_taylor_green import particle_plot
-from .tasks import SphgenProblem, Simulation
+from .tasks import SphgenProblem, Simulation, pick, read_results, run_state, state_suffix, state_text
 
 NX = 150
 TF = 25.0
@@ -39,18 +41,18 @@ def figure(sim_dir, out_dir, nx=NX):
     out = {}
     for ax, (name, label) in zip(axes, ((f"nx{nx}", "with corrections"), (f"nx{nx}_nocorr", "without corrections"))):
         folder = os.path.join(sim_dir, name)
-        try:
-            with open(os.path.join(folder, "results.json")) as fh:
-                res = json.load(fh)
-            last = io.output_files(folder, "cavity")[-1]
-        except (OSError, ValueError, IndexError):
-            ax.set_title(f"{label}: not run")
+        res = read_results(folder, "its largest empty disc")
+        files = io.output_files(folder, "cavity") if os.path.isdir(folder) else []
+        if not files or (res is None and run_state(folder) != "stopped"):
+            ax.set_title(f"{label}: {state_text(folder)}")
             continue
-        fl = io.load(last)["arrays"]["fluid"]
-        void = res["largest_empty_disc_over_dx"]
-        out[name] = {"t": res["t"], "largest_empty_disc_over_dx": void}
+        data = io.load(files[-1])
+        fl = data["arrays"]["fluid"]
+        out[name] = pick(folder, res, ("t", "largest_empty_disc_over_dx"))
+        void = out[name]["largest_empty_disc_over_dx"]
         particle_plot(f, ax, fl, np.hypot(fl.u, fl.v), "|u|",
-                      f"{label}, t = {res['t']:.3g}\nlargest empty disc {void:.2f} dx")
+                      f"{label}{state_suffix(folder)}, t = {data['solver_data']['t']:.3g}\nlargest empty disc "
+                      + ("missing (no results.json)" if void is None else f"{void:.2f} dx"))
     f.suptitle(f"Fig. 13: cavity Re = 100, {nx} x {nx}")
     f.tight_layout()
     f.savefig(os.path.join(out_dir, "fig13_cavity_void.png"), dpi=120)

@@ -18,7 +18,9 @@ physics):
   and GTVF; particles at four times, hole widths against the paper's.
 
 Every figure is drawn from the runs' own outputs (``history.json``, ``results.json``,
-``snapshot.npz``, the particle files).  ``python -m automation.ctvf_solids [outputs]
+``snapshot.npz``, the particle files).  A run the blow-up guard stopped is drawn up to its stop
+and labelled "stopped at t = ..."; the numbers only its results.json would hold are None in the
+summaries (and named in a printed note).  ``python -m automation.ctvf_solids [outputs]
 [quick]`` redraws from finished runs without running anything.
 """
 import json
@@ -29,7 +31,7 @@ import numpy as np
 
 from sphgen.tools.plots import particle_panels
 
-from .tasks import SphgenProblem, Simulation, paper_and_quick
+from .tasks import SphgenProblem, Simulation, paper_and_quick, pick, reached, read_results, run_state, state_suffix
 
 VF = (0.001, 0.01, 0.03, 0.05)
 """V_f of Table 1 (Adepu & Ramachandran 2021)."""
@@ -62,11 +64,10 @@ def _plt():
 
 
 def _read(folder, name):
-    """The JSON file ``name`` of a finished run, or None (not run, not finished)."""
+    """The JSON file ``name`` of a run that ended or was stopped, or None (not run, not ended)."""
+    if run_state(folder) == "not run":
+        return None
     try:
-        with open(os.path.join(folder, "info.json")) as f:
-            if not json.load(f).get("completed"):
-                return None
         with open(os.path.join(folder, name)) as f:
             return json.load(f)
     except (OSError, ValueError):
@@ -81,6 +82,21 @@ def _dump(out_dir, name, obj):
 def _rows(folder):
     hist = _read(folder, "history.json")
     return None if hist is None or not hist.get("rows") else np.array(hist["rows"], dtype=float)
+
+
+def _drawn(folder, keys, what):
+    """(results or None, summary entry, history rows) of a run that ended or was stopped (its
+    results.json-only ``keys`` None, ``what`` named in a note, if stopped); None if not run."""
+    rows = _rows(folder)
+    if rows is None:
+        return None
+    res = read_results(folder, what)
+    return res, pick(folder, res, keys), rows
+
+
+def _num(value, fmt, scale=1.0, unit=""):
+    """``value * scale`` formatted, or "n/a" for a missing value."""
+    return "n/a" if value is None else f"{value * scale:{fmt}}{unit}"
 
 
 def overlay(path, series, xlabel, ylabel, title, reference=None):
@@ -102,7 +118,8 @@ def overlay(path, series, xlabel, ylabel, title, reference=None):
 
 
 def snapshots(folder, app, arrays, times, value="p"):
-    """[(t, x, y, value)] from the particle files nearest to ``times`` (of the arrays named)."""
+    """[(t, x, y, value)] from the particle files nearest to ``times`` (of the arrays named); the
+    times a stopped run did not reach are left out."""
     from sphgen import io
     try:
         files = io.output_files(folder, app)
@@ -113,7 +130,7 @@ def snapshots(folder, app, arrays, times, value="p"):
     loaded = [io.load(f) for f in files]
     ts = np.array([d["solver_data"]["t"] for d in loaded])
     out = []
-    for t in times:
+    for t in (t for t in times if reached(folder, t, ts.max())):
         d = loaded[int(np.argmin(np.abs(ts - t)))]
         pas = [d["arrays"][a] for a in arrays]
         out.append((float(d["solver_data"]["t"]), *(np.concatenate([getattr(pa, c) for pa in pas])
@@ -146,20 +163,21 @@ def plate_figures(sim_dir, out_dir, cfg):
     summary, tips = {}, []
     for name, (label, _) in PLATE_CASES.items():
         folder = os.path.join(sim_dir, name)
-        res, rows = _read(folder, "results.json"), _rows(folder)
-        if res is None or rows is None:
+        got = _drawn(folder, ("t", "period", "period_paper", "period_error", "separated_upto", "separation_upto",
+                              "separation_time"), "its period and separation")
+        if got is None:
             continue
-        summary[name] = {k: res[k] for k in ("t", "period", "period_paper", "period_error", "separated_upto",
-                                             "separation_upto", "separation_time")}
-        tips.append((label, rows[:, 0], rows[:, 1]))
+        _, summary[name], rows = got
+        tips.append((label + state_suffix(folder), rows[:, 0], rows[:, 1]))
     panels = {}
     for name, (label, _) in PLATE_CASES.items():
         path = os.path.join(sim_dir, name, "snapshot.npz")
         if name in summary and os.path.exists(path):
             d = np.load(path)
             sep = summary[name]["separation_upto"]
-            panels[name] = (f"{label}, t = {float(d['t']):.3g} s: bond gap {sep['bond_gap_max']:.2f} dx, "
-                            f"{sep['pieces_max']} piece(s)", d["x"], d["y"], d["p"])
+            gap = "" if sep is None else f": bond gap {sep['bond_gap_max']:.2f} dx, {sep['pieces_max']} piece(s)"
+            panels[name] = (f"{label}{state_suffix(os.path.dirname(path))}, t = {float(d['t']):.3g} s{gap}",
+                            d["x"], d["y"], d["p"])
     for fig, names in (("fig18_gtvf.png", ("gtvf", "gtvf_spst")), ("fig19_ctvf_spst.png", ("ctvf_spst",)),
                        ("fig20_ctvf_spst_h001.png", ("ctvf_spst_h001",))):
         have = [panels[n] for n in names if n in panels]
@@ -183,21 +201,22 @@ def table1_figures(sim_dir, out_dir, cfg):
     rows, tips = {}, []
     for name, p in table1_cases(cfg).items():
         folder = os.path.join(sim_dir, name)
-        res, hist = _read(folder, "results.json"), _read(folder, "history.json")
-        if res is None or hist is None:
+        hist = _read(folder, "history.json")
+        if hist is None or not hist.get("rows"):
             continue
-        rows[name] = {"vf": p["vf"], "period": res["period"], "period_from": res["period_from"],
-                      "period_paper": PERIOD_PAPER[p["vf"]], "period_thin_plate": res["period_thin_plate"],
-                      "period_error": res["period_error"], "separated": res["separated"], "t": res["t"]}
+        res = read_results(folder, "its period")
+        rows[name] = {"vf": p["vf"], "period_paper": PERIOD_PAPER[p["vf"]],
+                      **pick(folder, res, ("period", "period_from", "period_thin_plate", "period_error",
+                                           "separated", "t"))}
         r = np.array(hist["rows"], dtype=float)
-        tips.append((f"V_f = {p['vf']:g}", r[:, 0], r[:, 1] / (p["vf"] * hist["c0"])))
+        tips.append((f"V_f = {p['vf']:g}{state_suffix(folder)}", r[:, 0], r[:, 1] / (p["vf"] * hist["c0"])))
     lines = ["| V_f | T (sphgen) | from | T_CTVF (Table 1) | error | T thin plate | separated |",
              "| --- | --- | --- | --- | --- | --- | --- |"]
-    for r in rows.values():
-        per = "n/a" if r["period"] is None else f"{r['period']:.4f} s"
-        err = "n/a" if r["period_error"] is None else f"{100 * r['period_error']:+.1f} %"
-        lines.append(f"| {r['vf']:g} | {per} | {r['period_from']} | {r['period_paper']} s | {err} | "
-                     f"{r['period_thin_plate']:.4f} s | {r['separated']} |")
+    for name, r in rows.items():
+        stop = state_suffix(os.path.join(sim_dir, name))
+        lines.append(f"| {r['vf']:g}{stop} | {_num(r['period'], '.4f', unit=' s')} | {_num(r['period_from'], '')} | "
+                     f"{r['period_paper']} s | {_num(r['period_error'], '+.1f', 100, ' %')} | "
+                     f"{_num(r['period_thin_plate'], '.4f', unit=' s')} | {_num(r['separated'], '')} |")
     with open(os.path.join(out_dir, "table1.md"), "w") as fh:
         fh.write("\n".join(lines) + "\n")
     _dump(out_dir, "table1.json", rows)
@@ -229,11 +248,12 @@ def fig21_figures(sim_dir, out_dir, cfg):
     series, summary = [], {}
     for name, p in fig21_cases(cfg).items():
         folder = os.path.join(sim_dir, name)
-        res, rows = _read(folder, "results.json"), _rows(folder)
-        if res is None or rows is None:
+        got = _drawn(folder, ("t", "dx", "period", "period_from", "period_paper", "separated"), "its period")
+        if got is None:
             continue
-        summary[name] = {k: res[k] for k in ("t", "dx", "period", "period_from", "period_paper", "separated")}
-        series.append((f"{p['nh']} across H (dx = {res['dx'] * 1e3:.3g} mm)", rows[:, 0], rows[:, 1]))
+        res, summary[name], rows = got
+        dx = "" if res is None else f" (dx = {res['dx'] * 1e3:.3g} mm)"
+        series.append((f"{p['nh']} across H{dx}{state_suffix(folder)}", rows[:, 0], rows[:, 1]))
     overlay(os.path.join(out_dir, "fig21_ipst_convergence.png"), series, "t [s]", "tip y [m]",
             "Fig. 21: CTVF + IPST, V_f = 0.05, L = 0.2, H = 0.02")
     _dump(out_dir, "summary.json", summary)
@@ -255,12 +275,13 @@ def uniaxial_figures(sim_dir, out_dir, cfg):
     series, summary, ramp = [], {}, None
     for name in uniaxial_cases(cfg):
         folder = os.path.join(sim_dir, name)
-        res, rows = _read(folder, "results.json"), _rows(folder)
-        if res is None or rows is None:
+        got = _drawn(folder, ("t", "von_mises_A_final", "von_mises_estimate_final", "von_mises_slope_over_estimate"),
+                     "its final von Mises stress")
+        if got is None:
             continue
-        summary[name] = {k: res[k] for k in ("t", "von_mises_A_final", "von_mises_estimate_final",
-                                             "von_mises_slope_over_estimate")}
-        series.append((name.replace("_", ", ").upper().replace("MM", " mm"), rows[:, 0] * 1e3, rows[:, 1] / 1e3))
+        _, summary[name], rows = got
+        series.append((name.replace("_", ", ").upper().replace("MM", " mm") + state_suffix(folder),
+                       rows[:, 0] * 1e3, rows[:, 1] / 1e3))
         ramp = (rows[:, 0] * 1e3, rows[:, 2] / 1e3, "E V t / ((1 - nu^2) H)")
     overlay(os.path.join(out_dir, "fig23_von_mises.png"), series, "t [ms]", "von Mises stress at A [kPa]",
             "Fig. 23 (Das & Cleary's curves not shipped: the free-side plane-strain ramp instead)", ramp)
@@ -291,11 +312,12 @@ def ring_figures(sim_dir, out_dir, cfg):
     times = cfg["tf"] * np.array([0.0, 1 / 3, 2 / 3, 1.0])
     for k, (name, (label, _)) in enumerate(RING_CASES.items()):
         folder = os.path.join(sim_dir, name)
-        res, rows = _read(folder, "results.json"), _rows(folder)
-        if res is None or rows is None:
+        got = _drawn(folder, ("t", "energy_final_over_initial", "energy_max_over_initial", "gap_final_over_dx",
+                              "separated", "bounced", "max_speed_over_c0"), "its energy, gap and bounce numbers")
+        if got is None:
             continue
-        summary[name] = {key: res[key] for key in ("t", "energy_final_over_initial", "energy_max_over_initial",
-                                                   "gap_final_over_dx", "separated", "bounced", "max_speed_over_c0")}
+        _, summary[name], rows = got
+        label += state_suffix(folder)
         t = rows[:, 0] * 1e3
         e = rows[:, 1] + rows[:, 2] + rows[:, 10]
         energy.append((label, t, e / e[0]))
@@ -335,20 +357,21 @@ def impact_figures(sim_dir, out_dir, cfg):
     times = cfg["tf"] * np.array([0.0, 0.25, 0.5, 1.0])
     for name, (label, _) in IMPACT_CASES.items():
         folder = os.path.join(sim_dir, name)
-        res = _read(folder, "results.json")
-        if res is None:
+        if run_state(folder) == "not run":
             continue
-        summary[name] = {k: res[k] for k in ("t", "hole_width", "hole_width_in_plane", "hole_paper", "hole_error")}
+        res = read_results(folder, "its hole width")
+        summary[name] = pick(folder, res, ("t", "hole_width", "hole_width_in_plane", "hole_paper", "hole_error"))
         snaps = snapshots(folder, "impact", ("solid",), times)
         if snaps:
             particle_panels(os.path.join(out_dir, f"fig29_impact_{name}.png"),
-                            [(f"Fig. 29: {label}, t = {ts * 1e6:.3g} us", x, y, p) for ts, x, y, p in snaps],
-                            size=(6.0, 4.5), marker=1)
+                            [(f"Fig. 29: {label}{state_suffix(folder)}, t = {ts * 1e6:.3g} us", x, y, p)
+                             for ts, x, y, p in snaps], size=(6.0, 4.5), marker=1)
     lines = ["| case | t | hole width (petals) | in plane | paper (CTVF) | error |", "| --- | --- | --- | --- | --- | --- |"]
     for name, r in summary.items():
-        lines.append(f"| {name} | {r['t'] * 1e6:.3g} us | {r['hole_width'] * 1e3:.3g} mm | "
-                     f"{r['hole_width_in_plane'] * 1e3:.3g} mm | {r['hole_paper'] * 1e3:.3g} mm | "
-                     f"{100 * r['hole_error']:+.1f} % |")
+        t = r["t"] if r["t"] is not None else r.get("stopped_at")
+        widths = " | ".join(_num(r[k], ".3g", 1e3, " mm") for k in ("hole_width", "hole_width_in_plane", "hole_paper"))
+        lines.append(f"| {name}{state_suffix(os.path.join(sim_dir, name))} | {_num(t, '.3g', 1e6, ' us')} | "
+                     f"{widths} | {_num(r['hole_error'], '+.1f', 100, ' %')} |")
     with open(os.path.join(out_dir, "summary.md"), "w") as fh:
         fh.write("\n".join(lines) + "\n")
     _dump(out_dir, "summary.json", summary)

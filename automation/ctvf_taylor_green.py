@@ -14,7 +14,9 @@ coloured by pressure at t = 2, Re 1000, 150 x 150, SPST); ``baselines.png`` and
 deviation of max |u| from the exact decay, CTVF against EDAC and GTVF).
 
 ``python -m automation.ctvf_taylor_green [outputs]`` draws what the finished cases allow
-(missing cases are left out and listed), without running anything.
+(missing cases are left out and listed), without running anything.  A case the blow-up guard
+stopped is drawn up to its stop, labelled "stopped at t = ..."; its L1 at t = 2 and the orders
+that need it are NaN (None in summary.json), with a printed note.
 """
 import json
 import os
@@ -22,7 +24,7 @@ import sys
 
 import numpy as np
 
-from .tasks import SphgenProblem, Simulation
+from .tasks import SphgenProblem, Simulation, missing, run_info, run_state, state_suffix
 
 RES = (100, 1000)
 SHIFTINGS = ("spst", "ipst")
@@ -71,16 +73,19 @@ def _legend(ax):
 
 
 def history(folder):
-    """(t, max|u|, exact max|u|, L1) of a finished run, or None."""
+    """(t, max|u|, exact max|u|, L1) of a run that ended or was stopped (up to its stop), or None."""
+    if run_state(folder) == "not run":
+        return None
     try:
-        with open(os.path.join(folder, "info.json")) as f:
-            if not json.load(f).get("completed"):
-                return None
         with open(os.path.join(folder, "history.json")) as f:
             rows = np.array(json.load(f)["rows"])
     except (OSError, ValueError, KeyError):
         return None
     return rows[:, 0], rows[:, 1], rows[:, 2], rows[:, 3]
+
+
+def _none_if_nan(v):
+    return None if np.isnan(v) else v
 
 
 def order(e1, e2, n1, n2):
@@ -93,8 +98,11 @@ def figures(sim_dir, out_dir, nx=NX):
     plt = _plt()
     os.makedirs(out_dir, exist_ok=True)
     hist = {name: history(os.path.join(sim_dir, name)) for name, _ in all_cases(nx)}
-    missing = sorted(k for k, v in hist.items() if v is None)
-    summary = {"tf": TF, "missing": missing, "runs": {}, "orders": {}, "baselines": {}}
+    folder = {name: os.path.join(sim_dir, name) for name in hist}
+    label = {name: state_suffix(f) for name, f in folder.items()}         # " (stopped at t = ...)" or ""
+    stopped = {name: run_info(f).get("t") for name, f in folder.items() if run_state(f) == "stopped"}
+    summary = {"tf": TF, "missing": sorted(k for k, v in hist.items() if v is None), "stopped": stopped,
+               "runs": {}, "orders": {}, "baselines": {}}
     for name, h in hist.items():
         if h is not None:
             t, umax, uex, l1 = h
@@ -102,15 +110,17 @@ def figures(sim_dir, out_dir, nx=NX):
                                      "t_of_l1_max": float(t[np.argmax(l1)]),
                                      "max_u_dev_max": float(np.abs(umax / uex - 1).max()),
                                      "max_u_dev_final": float(umax[-1] / uex[-1] - 1)}
+            if name in stopped:      # its values are up to the stop, not at t = 2
+                summary["runs"][name]["stopped_at"] = stopped[name]
     # Figs. 6-9: decay and L1 over nx
     for fig, re, s in ((6, 100, "spst"), (7, 100, "ipst"), (8, 1000, "ipst"), (9, 1000, "spst")):
         f, (a, b) = plt.subplots(1, 2, figsize=(10, 4))
         have = [(n, hist[case_name(re, "ctvf", s, n)]) for n in nx if hist[case_name(re, "ctvf", s, n)] is not None]
         for n, (t, umax, uex, l1) in have:
-            a.semilogy(t, umax, label=f"{n} x {n}")
-            b.plot(t, l1, label=f"{n} x {n}")
+            a.semilogy(t, umax, label=f"{n} x {n}{label[case_name(re, 'ctvf', s, n)]}")
+            b.plot(t, l1, label=f"{n} x {n}{label[case_name(re, 'ctvf', s, n)]}")
         if have:
-            t, _, uex, _ = have[0][1]
+            t, _, uex, _ = max((h for _, h in have), key=lambda h: h[0][-1])
             a.semilogy(t, uex, "k--", label="exact")
         a.set_ylabel("max |u|")
         b.set_ylabel("$L_1$ error of |u| (eq. 66)")
@@ -121,10 +131,12 @@ def figures(sim_dir, out_dir, nx=NX):
         f.tight_layout()
         f.savefig(os.path.join(out_dir, f"fig{fig:02d}_re{re}_{s}.png"), dpi=120)
         plt.close(f)
-        final = [(n, summary["runs"][case_name(re, "ctvf", s, n)]["l1_final"]) for n, _ in have]
+        final = [(n, _l1_at_end(folder[case_name(re, "ctvf", s, n)], summary["runs"][case_name(re, "ctvf", s, n)]))
+                 for n, _ in have]
         summary["orders"][f"re{re}_{s}"] = {
-            "l1_final": {str(n): e for n, e in final},
-            "order": [{"nx": [n1, n2], "p": order(e1, e2, n1, n2)} for (n1, e1), (n2, e2) in zip(final, final[1:])]}
+            "l1_final": {str(n): _none_if_nan(e) for n, e in final},
+            "order": [{"nx": [n1, n2], "p": _none_if_nan(order(e1, e2, n1, n2))}
+                      for (n1, e1), (n2, e2) in zip(final, final[1:])]}
     # Figs. 10-11: with and without corrections at the finest nx that has both runs
     for fig, s in ((10, "spst"), (11, "ipst")):
         f, axes = plt.subplots(1, 2, figsize=(10, 4))
@@ -135,7 +147,8 @@ def figures(sim_dir, out_dir, nx=NX):
             for corr, style in ((True, "-"), (False, "--")):
                 h = hist[case_name(re, "ctvf", s, n, corr)]
                 if h is not None:
-                    ax.plot(h[0], h[3], style, label="with corrections" if corr else "without corrections")
+                    ax.plot(h[0], h[3], style, label=("with corrections" if corr else "without corrections")
+                            + label[case_name(re, "ctvf", s, n, corr)])
             ax.set_title(f"Re = {re}, {n} x {n}")
             ax.set_xlabel("t")
             ax.set_ylabel("$L_1$ error of |u|")
@@ -151,13 +164,13 @@ def figures(sim_dir, out_dir, nx=NX):
     f, axes = plt.subplots(1, 2, figsize=(10, 4))
     for ax, re in zip(axes, RES):
         row = {}
-        for label, name in (("CTVF SPST", case_name(re, "ctvf", "spst", BASELINE_NX)),
+        for scheme, name in (("CTVF SPST", case_name(re, "ctvf", "spst", BASELINE_NX)),
                             ("CTVF IPST", case_name(re, "ctvf", "ipst", BASELINE_NX)),
                             ("EDAC", case_name(re, "edac", nx=BASELINE_NX)),
                             ("GTVF", case_name(re, "gtvf", nx=BASELINE_NX))):
             if hist[name] is not None:
-                ax.plot(hist[name][0], hist[name][3], label=label)
-                row[label] = summary["runs"][name]
+                ax.plot(hist[name][0], hist[name][3], label=scheme + label[name])
+                row[scheme] = summary["runs"][name]
         summary["baselines"][f"re{re}_nx{BASELINE_NX}"] = row
         ax.set_title(f"Re = {re}, {BASELINE_NX} x {BASELINE_NX}")
         ax.set_xlabel("t")
@@ -178,15 +191,26 @@ def summary_table(summary):
     lines = ["| case | L1 at t = 2 | largest L1 (at t) | largest \\|max\\|u\\|/exact - 1\\| |",
              "| --- | --- | --- | --- |"]
     for name, r in sorted(summary["runs"].items()):
-        lines.append(f"| {name} | {r['l1_final']:.4f} | {r['l1_max']:.4f} ({r['t_of_l1_max']:.3g}) | "
+        at = r.get("stopped_at")
+        end = f"{r['l1_final']:.4f}" if at is None else f"NaN (stopped at t = {at:.4g})"
+        lines.append(f"| {name} | {end} | {r['l1_max']:.4f} ({r['t_of_l1_max']:.3g}) | "
                      f"{100 * r['max_u_dev_max']:.2f} % |")
     lines += ["", "| series | nx | order of L1 at t = 2 |", "| --- | --- | --- |"]
     for key, o in sorted(summary["orders"].items()):
         for p in o["order"]:
-            lines.append(f"| {key} | {p['nx'][0]} -> {p['nx'][1]} | {p['p']:.2f} |")
+            p_text = "NaN" if p["p"] is None else f"{p['p']:.2f}"
+            lines.append(f"| {key} | {p['nx'][0]} -> {p['nx'][1]} | {p_text} |")
     if summary["missing"]:
         lines += ["", "not run: " + ", ".join(summary["missing"])]
     return "\n".join(lines) + "\n"
+
+
+def _l1_at_end(folder, run):
+    """The run's L1 at t = 2 (its last sample), or NaN with a printed note if it was stopped."""
+    if "stopped_at" not in run:
+        return run["l1_final"]
+    missing(folder, f"its L1 at t = {TF:g} (and the orders that use it)", "the run did not reach it")
+    return float("nan")
 
 
 def particle_plot(fig, ax, pa, values, label, title):
@@ -206,7 +230,8 @@ def _pressure_plot(plt, folder, path):
     data = io.load(last)
     f, ax = plt.subplots(figsize=(5.5, 4.5))
     fl = data["arrays"]["fluid"]
-    particle_plot(f, ax, fl, fl.p, "p", f"Fig. 12: Re = 1000, t = {data['solver_data']['t']:.3g}")
+    particle_plot(f, ax, fl, fl.p, "p", f"Fig. 12: Re = 1000, t = {data['solver_data']['t']:.3g}"
+                  + state_suffix(folder))
     f.tight_layout()
     f.savefig(path, dpi=120)
     plt.close(f)

@@ -20,7 +20,9 @@ cavity at Re 400 and 1000 with delta t = tau/3, below the relaxation guard's 0.4
 ``python automate.py shtc_quick`` the quick one (coarse levels; the cavity at Re 100 with cs = 10
 and delta t = tau/3 as docs/shtc.md's row 7, at Re 400 and 1000 with cs = 5 so that delta t = tau/3
 is four times larger; meant for under 30 minutes on 2 cores).  A figure whose
-runs are missing is drawn with "not run" panels.  ``python -m automation.shtc [outputs] [quick]``
+runs are missing is drawn with "not run" panels; a run the blow-up guard stopped is drawn up to
+its stop and labelled "stopped at t = ...", and what only its results.json would hold is left
+out (None in the figure's json, named in a printed note).  ``python -m automation.shtc [outputs] [quick]``
 redraws from finished runs.
 """
 import os
@@ -29,8 +31,8 @@ import sys
 
 import numpy as np
 
-from .superfluid import _json, _plt, _save
-from .tasks import SphgenProblem, Simulation
+from .superfluid import _plt, _save
+from .tasks import SphgenProblem, Simulation, pick, reached, read_results, run_state, state_suffix, state_text
 from .thermo import _dump, history
 
 # the cavity's snapshots ([P] Figs. 10-11, [T] Figs. 2.4-2.5): the captions give no times
@@ -141,13 +143,46 @@ def nearest(files, times):
     return out
 
 
+def snapshots_upto_stop(folder, prefix, times):
+    """:func:`nearest` of the run's files, with None for the times a stopped run did not reach."""
+    files = outputs(folder, prefix)
+    return {t: hit if files and reached(folder, t, files[-1][0]) else None
+            for t, hit in nearest(files, times).items()}
+
+
 def _prop(pa, name):
     return np.asarray(pa.get(name))
 
 
-def _not_run(ax, title=""):
-    ax.text(0.5, 0.5, "not run", ha="center", va="center", transform=ax.transAxes)
+def _not_run(ax, title="", run=None):
+    """An empty panel: "not run", or "stopped at t = ..." for a run the guard stopped."""
+    ax.text(0.5, 0.5, "not run" if run is None else state_text(run), ha="center", va="center",
+            transform=ax.transAxes)
     ax.set_title(title, fontsize=8)
+
+
+def _summary(run, keys, what):
+    """{key: value} of the run's results.json (the ``keys`` it has, all if None); None if it
+    has none; ``stopped_at`` only (and a note naming ``what``) if the guard stopped it."""
+    res = read_results(run, what)
+    if res is not None:
+        return {k: res[k] for k in keys if k in res} if keys else res
+    return pick(run, None, ()) if run_state(run) == "stopped" else None
+
+
+def _mark_stopped(png, run):
+    """Redraw the figure file ``png`` of a stopped run with "stopped at t = ..." above it."""
+    if run_state(run) != "stopped":
+        return
+    plt = _plt()
+    image = plt.imread(png)
+    fig = plt.figure(figsize=(image.shape[1] / 100, image.shape[0] / 100 + 0.4))
+    ax = fig.add_axes((0, 0, 1, image.shape[0] / (image.shape[0] + 40)))
+    ax.imshow(image)
+    ax.axis("off")
+    fig.suptitle(f"{os.path.basename(os.path.normpath(run))}{state_suffix(run)}", fontsize=9)
+    fig.savefig(png, dpi=100)
+    plt.close(fig)
 
 
 def _copy_plot(src_folder, png, out_dir, name, title):
@@ -159,7 +194,7 @@ def _copy_plot(src_folder, png, out_dir, name, title):
         return True
     plt = _plt()
     fig, ax = plt.subplots(figsize=(5, 3))
-    _not_run(ax, title)
+    _not_run(ax, title, src_folder)
     _save(fig, out_dir, name)
     return False
 
@@ -241,7 +276,7 @@ def plate_figures(sim_dir, out_dir, cfg):
         if h is None:
             _not_run(ax)
         else:
-            ax.plot(h["t"], h["y_centre"], "C1-", label="SHTC-SPH (sphgen)")
+            ax.plot(h["t"], h["y_centre"], "C1-", label="SHTC-SPH (sphgen)" + state_suffix(run["plate_cp10"]))
             ax.legend(fontsize=7)
         ax.set_xlabel("t [s]")
         ax.set_ylabel("y of the centre point [m]")
@@ -259,7 +294,7 @@ def plate_figures(sim_dir, out_dir, cfg):
                 ax.plot(h["t"], h[part] / e0, label=part)
             drift = float(np.abs(h["total"] / h["total"][0] - 1.0).max())
             ax.legend(fontsize=7)
-            title += f"; largest relative drift of the total {drift:.2g}"
+            title += f"; largest relative drift of the total {drift:.2g}" + state_suffix(run["plate_cp10"])
         ax.set_xlabel("t [s]")
         ax.set_ylabel("E / E(0)" if norm else "E [J/m]")
         ax.set_title(title, fontsize=8)
@@ -272,7 +307,7 @@ def plate_figures(sim_dir, out_dir, cfg):
             _not_run(ax, label)
             continue
         shot = nearest(files, (files[-1][0],))[files[-1][0]]
-        _pressure(fig, ax, shot[0]["plate"], f"{label}, t = {shot[1]:.3g} s")
+        _pressure(fig, ax, shot[0]["plate"], f"{label}, t = {shot[1]:.3g} s{state_suffix(run[key])}")
     fig.suptitle("[P] Fig. 4: pressure with the tensile penalty (top) and without (bottom)", fontsize=9)
     _save(fig, out_dir, "P_fig4")
     # [T] Fig. 2.1: three times of the run with the penalty
@@ -285,12 +320,12 @@ def plate_figures(sim_dir, out_dir, cfg):
             _not_run(ax, "c_p = 10 c0")
         else:
             _pressure(fig, ax, shots[t][0]["plate"], f"t = {shots[t][1]:.3g} s")
-    fig.suptitle("[T] Fig. 2.1: the plate at three times (c_p = 10 c0), pressure", fontsize=9)
+    fig.suptitle("[T] Fig. 2.1: the plate at three times (c_p = 10 c0), pressure" + state_suffix(run["plate_cp10"]),
+                 fontsize=9)
     _save(fig, out_dir, "T_fig2_1")
-    res = {k: _json(v, "results.json") for k, v in run.items()}
     keep = ("energy_drift", "period", "period_error_euler_bernoulli", "period_error_timoshenko",
             "period_error_initial_omega", "void_fraction", "clump_fraction", "torn", "nw", "t")
-    out = {k: {q: r[q] for q in keep if q in r} if r else None for k, r in res.items()}
+    out = {k: _summary(v, keep, "its period, drift and tearing numbers") for k, v in run.items()}
     _dump(out_dir, "P_fig4", out)
     return out
 
@@ -310,11 +345,11 @@ def column_figures(sim_dir, out_dir, cfg):
     from sphgen.applications.twisting_column import H
     plt = _plt()
     run = os.path.join(sim_dir, "column")
-    shots = nearest(outputs(run, "twisting_column"), COLUMN_TIMES)
+    shots = snapshots_upto_stop(run, "twisting_column", COLUMN_TIMES)
     fig, axes = plt.subplots(1, len(COLUMN_TIMES), figsize=(2.6 * len(COLUMN_TIMES) + 1, 6))
     for ax, t in zip(axes, COLUMN_TIMES):
         if shots[t] is None:
-            _not_run(ax, f"t = {t:g} s")
+            _not_run(ax, f"t = {t:g} s", run)
             continue
         pa = shots[t][0]["column"]
         size = float(np.clip(12000.0 / max(pa.n, 1), 0.3, 20.0))
@@ -324,7 +359,8 @@ def column_figures(sim_dir, out_dir, cfg):
         ax.set_aspect("equal")
         ax.set_title(f"t = {shots[t][1]:.3g} s", fontsize=8)
         fig.colorbar(sc, ax=ax, shrink=0.6)
-    fig.suptitle("[P] Fig. 5: twisting column, pressure [Pa] (1-99 % range), side view (x, z)", fontsize=9)
+    fig.suptitle("[P] Fig. 5: twisting column, pressure [Pa] (1-99 % range), side view (x, z)" + state_suffix(run),
+                 fontsize=9)
     _save(fig, out_dir, "P_fig5")
     h = history(run)
     fig, ax = plt.subplots(figsize=(6, 3.6))
@@ -336,19 +372,19 @@ def column_figures(sim_dir, out_dir, cfg):
         ax.legend(fontsize=7)
     ax.set_xlabel("t [s]")
     ax.set_ylabel("E [J]")
-    ax.set_title("[P] Fig. 6: energy of the twisting column", fontsize=8)
+    ax.set_title("[P] Fig. 6: energy of the twisting column" + state_suffix(run), fontsize=8)
     _save(fig, out_dir, "P_fig6")
     fig, ax = plt.subplots(figsize=(6, 3.6))
     if h is None:
         _not_run(ax)
     else:
-        ax.plot(h["t"], h["z_top"] / H, "C1-", label="SHTC-SPH (sphgen)")
+        ax.plot(h["t"], h["z_top"] / H, "C1-", label="SHTC-SPH (sphgen)" + state_suffix(run))
         ax.legend(fontsize=7)
     ax.set_xlabel("t [s]")
     ax.set_ylabel("z / H of the point initially at (0, 0, H)")
     ax.set_title("[P] Fig. 7: ours only (the paper's FEniCS curve is not available)", fontsize=8)
     _save(fig, out_dir, "P_fig7")
-    res = _json(run, "results.json")
+    res = _summary(run, None, "its results")
     _dump(out_dir, "P_fig7", res or {})
     return res
 
@@ -357,11 +393,12 @@ def column_figures(sim_dir, out_dir, cfg):
 def couette_figures(sim_dir, out_dir, cfg):
     plt = _plt()
     run = os.path.join(sim_dir, "couette")
-    res = _json(run, "results.json")
+    out = _summary(run, None, "its velocity profile ([P] Fig. 8)")
+    res = None if out is None or "stopped_at" in out else out
     fig, (a, b) = plt.subplots(1, 2, figsize=(10, 4))
     if res is None:
-        _not_run(a)
-        _not_run(b)
+        _not_run(a, run=run)
+        _not_run(b, run=run)
     else:
         x, v, ve = (np.array(res[k]) for k in ("profile_x", "profile_v", "profile_exact"))
         for ax, shift in ((a, 0.0), (b, 1.0)):
@@ -380,10 +417,10 @@ def couette_figures(sim_dir, out_dir, cfg):
         _not_run(ax)
     else:
         shot = nearest(files, (files[-1][0],))[files[-1][0]]
-        _field(fig, ax, shot[0], ("fluid",), "Axy", f"t = {shot[1]:.3g}")
+        _field(fig, ax, shot[0], ("fluid",), "Axy", f"t = {shot[1]:.3g}{state_suffix(run)}")
     fig.suptitle("[P] Fig. 9: $A_{xy}$ (Taylor-Couette)", fontsize=9)
     _save(fig, out_dir, "P_fig9")
-    return res
+    return out
 
 
 def _value(pa, what):
@@ -416,29 +453,29 @@ def _field(fig, ax, arrays, names, what, title, lim=None):
 def cavity_evolution(out_dir, name, folder, what, suptitle):
     """One field of the Re = 100 cavity at CAVITY_TIMES (one panel each)."""
     plt = _plt()
-    shots = nearest(outputs(folder, "shtc_cavity"), CAVITY_TIMES)
+    shots = snapshots_upto_stop(folder, "shtc_cavity", CAVITY_TIMES)
     fig, axes = plt.subplots(1, len(CAVITY_TIMES), figsize=(3.6 * len(CAVITY_TIMES), 3.4))
     shown = {}
     for ax, t in zip(axes, CAVITY_TIMES):
         if shots[t] is None:
-            _not_run(ax, f"t = {t:g}")
+            _not_run(ax, f"t = {t:g}", folder)
             continue
         shown[f"{t:g}"] = dict(t=shots[t][1], **_field(fig, ax, shots[t][0], ("fluid",), what,
                                                         f"t = {shots[t][1]:.4g}"))
-    fig.suptitle(suptitle, fontsize=9)
+    fig.suptitle(suptitle + state_suffix(folder), fontsize=9)
     _save(fig, out_dir, name)
     _dump(out_dir, name, shown)
     return shown
 
 
-def _centrelines(ax_u, ax_v, res, ghia, re, cs):
+def _centrelines(ax_u, ax_v, res, ghia, re, cs, run):
     """v_x on x = 1/2 against y and v_y on y = 1/2 against x: the run's (at the end, and averaged
     over the second half of the run) and Ghia et al. (1982)."""
     ax_u.plot(ghia["u"], ghia["y"], "ks", mfc="none", ms=4, label="Ghia et al. (1982)")
     ax_v.plot(ghia["x"], ghia["v"], "ks", mfc="none", ms=4, label="Ghia et al. (1982)")
     if res is None:
-        _not_run(ax_u, f"Re = {re}")
-        _not_run(ax_v, f"Re = {re}")
+        _not_run(ax_u, f"Re = {re}", run)
+        _not_run(ax_v, f"Re = {re}", run)
         return
     ax_u.plot(res["u_centre"], ghia["y"], "C1-", label=f"SHTC-SPH, t = {res['t']:.3g}")
     ax_v.plot(ghia["x"], res["v_centre"], "C1-", label=f"SHTC-SPH, t = {res['t']:.3g}")
@@ -461,17 +498,17 @@ def centreline_figure(out_dir, name, sim_dir, cfg, res_list, suptitle):
     fig, axes = plt.subplots(2, len(res_list), figsize=(4.2 * len(res_list), 7.2), squeeze=False)
     out = {}
     for k, re in enumerate(res_list):
-        res = _json(runs[re], "results.json")
-        _centrelines(axes[0][k], axes[1][k], res, ghia_1982(re), re, speeds[re])
+        res = read_results(runs[re], "its centre-line velocities")
+        _centrelines(axes[0][k], axes[1][k], res, ghia_1982(re), re, speeds[re], runs[re])
         axes[0][k].set_xlabel("$v_x$ on x = 1/2")
         axes[0][k].set_ylabel("y")
         axes[1][k].set_xlabel("x")
         axes[1][k].set_ylabel("$v_y$ on y = 1/2")
         axes[0][k].legend(fontsize=6)
-        if res is not None:
-            out[f"Re{re}"] = {q: res.get(q) for q in ("nx", "t", "ghia_error", "ghia_error_averaged",
-                                                        "ghia_error_window", "ghia_error_interior",
-                                                        "dt_over_tau", "viscosity_factor", "max_density_error")}
+        if res is not None or run_state(runs[re]) == "stopped":
+            out[f"Re{re}"] = pick(runs[re], res, ("nx", "t", "ghia_error", "ghia_error_averaged", "ghia_error_window",
+                                                  "ghia_error_interior", "dt_over_tau", "viscosity_factor",
+                                                  "max_density_error"))
     fig.suptitle(suptitle, fontsize=9)
     _save(fig, out_dir, name)
     _dump(out_dir, name, out)
@@ -500,8 +537,8 @@ def thesis_figures(sim_dir, out_dir, cfg):
                                                    out_dir, "T_sec2_2_impulse_of_shear", "[T] sec. 2.2"),
            "P_sec3_6_reversibility": _copy_plot(os.path.join(sim_dir, "reversibility"), "return.png", out_dir,
                                                 "P_sec3_6_reversibility", "[P] sec. 3.6")}
-    return {k: _json(os.path.join(sim_dir, f), "results.json") if v else None
-            for (k, v), f in zip(got.items(), ("kernel_convergence", "impulse_of_shear", "reversibility"))}
+    return {k: _summary(os.path.join(sim_dir, f), None, "its results")
+            for k, f in zip(got, ("kernel_convergence", "impulse_of_shear", "reversibility"))}
 
 
 DAM_BREAK_KEYS = ("dx", "t", "T", "toe_max_rel_dev_violeau", "toe_signed_dev_at_max_violeau",
@@ -511,22 +548,24 @@ DAM_BREAK_KEYS = ("dx", "t", "T", "toe_max_rel_dev_violeau", "toe_signed_dev_at_
 
 def dam_break_figures(sim_dir, out_dir, cfg):
     """[T] Figs. 1.2 (snapshots, |v|) and 1.3 (the wavefront against Violeau and Koshizuka & Oka),
-    drawn by the dam break application from its run; "not run" panels without one."""
+    drawn by the dam break application from its run (up to the stop, marked, if the guard
+    stopped it); "not run" panels without one."""
     from sphgen.applications.dam_break_2d import thesis_figure_1_2, thesis_figure_1_3
     run = os.path.join(sim_dir, "dam_break")
-    done = _json(run, "info.json") or {}
+    drawn = run_state(run) != "not run"
     for name, draw, title in (("T_fig1_2", thesis_figure_1_2, "[T] Fig. 1.2: dam break snapshots, |v|"),
                               ("T_fig1_3", thesis_figure_1_3, "[T] Fig. 1.3: wavefront x/a against T")):
-        if done.get("completed"):
+        if drawn:
             os.makedirs(os.path.join(out_dir, name), exist_ok=True)
             draw(run, os.path.join(out_dir, name, name + ".png"))
+            _mark_stopped(os.path.join(out_dir, name, name + ".png"), run)
         else:
             plt = _plt()
             fig, ax = plt.subplots(figsize=(5, 3))
             _not_run(ax, title)
             _save(fig, out_dir, name)
-    res = _json(run, "results.json")
-    out = {k: res.get(k) for k in DAM_BREAK_KEYS} if res else None
+    res = read_results(run, "its wavefront deviations")
+    out = pick(run, res, DAM_BREAK_KEYS) if res or run_state(run) == "stopped" else None
     _dump(out_dir, "T_fig1_3", out or {})
     return out
 

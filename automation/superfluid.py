@@ -18,7 +18,9 @@ under half an hour on 2 cores; not timed).  Each figure goes to a folder named a
 * ``fig3_7``: |v| at the end, three powers;
 * ``fig3_8``: T and the shape at 80 W/m every tf/8 (37.5 ms for the paper preset).
 
-A figure whose runs are missing is drawn with "not run" panels.
+A figure whose runs are missing is drawn with "not run" panels.  A run the blow-up guard stopped
+is drawn up to its stop, labelled "stopped at t = ..."; the points only its results.json would
+give (Figs. 3.2, 3.5) are left out, named in the legend or title and in a printed note.
 ``python -m automation.superfluid [outputs] [quick]`` redraws from finished runs.
 """
 import json
@@ -29,7 +31,7 @@ import numpy as np
 
 from sphgen.applications.second_sound import loglog_slope
 
-from .tasks import SphgenProblem, Simulation
+from .tasks import SphgenProblem, Simulation, reached, read_results, state_suffix, state_text, stopped_marks
 
 CONFIG = {
     "paper": dict(N=(100, 200, 300), A=(0.01, 0.03, 0.05, 0.1), energy_N=200, Ms=(25, 50, 100),
@@ -120,21 +122,23 @@ def fig3_2(sim_dir, out_dir, cfg):
     fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4))
     data = {"entropy_error": {}, "energy_error": {}, "energy_slope": {}}
     for N in cfg["N"]:
-        pts = [[A, r["entropy_error"]] for A in cfg["A"]
-               if (r := _json(os.path.join(sim_dir, ss_name(N, A, M_ENTROPY)), "results.json"))]
+        runs = {f"A = {A:g}": os.path.join(sim_dir, ss_name(N, A, M_ENTROPY)) for A in cfg["A"]}
+        pts = [[A, r["entropy_error"]] for A, run in zip(cfg["A"], runs.values())
+               if (r := read_results(run, "its entropy error (Fig. 3.2)"))]
         data["entropy_error"][str(N)] = pts
         if pts:
-            a.plot(*zip(*pts), "o-", label=f"N = {N}")
+            a.plot(*zip(*pts), "o-", label=f"N = {N}{stopped_marks(runs)}")
     a.set_xlabel("A")
     a.set_ylabel("max RMS (s - s_exact)/(A s0)")
     a.set_title(f"entropy error, M = {M_ENTROPY}, one period")
     for A in cfg["energy_A"]:
-        pts = [[M, r["energy_error"]] for M in cfg["Ms"]
-               if (r := _json(os.path.join(sim_dir, ss_name(cfg["energy_N"], A, M)), "results.json"))]
+        runs = {f"M = {M:g}": os.path.join(sim_dir, ss_name(cfg["energy_N"], A, M)) for M in cfg["Ms"]}
+        pts = [[M, r["energy_error"]] for M, run in zip(cfg["Ms"], runs.values())
+               if (r := read_results(run, "its energy error (Fig. 3.2)"))]
         data["energy_error"][f"{A:g}"] = pts
         if pts:
             M, e = np.array(pts).T
-            label = f"A = {A:g}"
+            label = f"A = {A:g}{stopped_marks(runs)}"
             if len(pts) > 1:   # the log-log slope of the energy error against M (issue 13)
                 data["energy_slope"][f"{A:g}"] = slope = loglog_slope(M, e)
                 label += f", slope {slope:.2f}"
@@ -158,7 +162,8 @@ def fig3_3(sim_dir, out_dir, cfg):
     from sphgen.applications.second_sound import MODEL
     plt = _plt()
     N = max(cfg["N"])
-    hist = _json(os.path.join(sim_dir, ss_name(N, 0.01, M_ENTROPY)), "history.json")
+    run = os.path.join(sim_dir, ss_name(N, 0.01, M_ENTROPY))
+    hist = _json(run, "history.json")
     fig, ax = plt.subplots(figsize=(6, 4))
     if hist is None:
         ax.text(0.5, 0.5, "not run", ha="center", transform=ax.transAxes)
@@ -166,7 +171,7 @@ def fig3_3(sim_dir, out_dir, cfg):
         rows = np.array(hist["rows"])
         c = {k: rows[:, i] for i, k in enumerate(hist["columns"])}
         ax.plot(c["t"] * 1e3, c["s_probe_exact"] - MODEL.s0, "k-", label="eq. 3.51")
-        ax.plot(c["t"][::4] * 1e3, c["s_probe"][::4] - MODEL.s0, "r.", ms=4, label="sphgen")
+        ax.plot(c["t"][::4] * 1e3, c["s_probe"][::4] - MODEL.s0, "r.", ms=4, label="sphgen" + state_suffix(run))
         ax.legend()
     ax.set_xlabel("t [ms]")
     ax.set_ylabel("s - s0 at (L/4, L/4) [J/(kg K)]")
@@ -199,8 +204,9 @@ def fig3_5(sim_dir, out_dir, cfg):
     plt = _plt()
     fig, ax = plt.subplots(figsize=(6, 4))
     out = {}
-    for W, color in zip((60, 80), ("tab:blue", "tab:red")):
-        res = _json(os.path.join(sim_dir, f"fountain_W{W}"), "results.json")
+    runs = {f"{W} W/m": os.path.join(sim_dir, f"fountain_W{W}") for W in (60, 80)}
+    for (W, run), color in zip(zip((60, 80), runs.values()), ("tab:blue", "tab:red")):
+        res = read_results(run, "its flux series (Fig. 3.5)")
         if res is None:
             continue
         fs = np.array(res["flux_series"])
@@ -217,15 +223,16 @@ def fig3_5(sim_dir, out_dir, cfg):
         ax.legend(fontsize=7)
     ax.set_xlabel("t [s]")
     ax.set_ylabel("v_jet [m/s]")
-    ax.set_title("Fig. 3.5: jet speed", fontsize=9)
+    ax.set_title("Fig. 3.5: jet speed" + stopped_marks(runs), fontsize=9)
     folder = _save(fig, out_dir, "fig3_5")
     with open(os.path.join(folder, "fig3_5.json"), "w") as f:
         json.dump(out, f, indent=1)
     return out
 
 
-def snapshots(folder, times):
-    """{time: output file} of the files nearest to each time (None if no file)."""
+def snapshots(folder, times, upto_stop=True):
+    """{time: (output file, its time)} of the files nearest to each time: None if no file or,
+    with ``upto_stop``, a time the run did not reach before the guard stopped it."""
     from sphgen import io
     try:
         files = io.output_files(folder, "fountain")
@@ -234,15 +241,16 @@ def snapshots(folder, times):
     if not files:
         return {t: None for t in times}
     have = np.array([io.read_solver_data(p)["t"] for p in files])
-    return {t: (files[int(np.argmin(np.abs(have - t)))], float(have[np.argmin(np.abs(have - t))])) for t in times}
+    return {t: (files[int(np.argmin(np.abs(have - t)))], float(have[np.argmin(np.abs(have - t))]))
+            if not upto_stop or reached(folder, t, have.max()) else None for t in times}
 
 
-def _field_panels(ax_list, shots, field, label, window, cmap):
+def _field_panels(ax_list, shots, field, label, window, cmap, run):
     from sphgen import io
     from sphgen.applications.fountain import MODEL
     for ax, (t, hit) in zip(ax_list, shots.items()):
         if hit is None:
-            ax.text(0.5, 0.5, "not run", ha="center", transform=ax.transAxes)
+            ax.text(0.5, 0.5, state_text(run), ha="center", transform=ax.transAxes)
             ax.set_title(f"t = {t * 1e3:g} ms", fontsize=8)
             continue
         path, t_file = hit
@@ -264,9 +272,11 @@ def fig3_6(sim_dir, out_dir):
     """T - T0 in the cell at 0.25, 0.5, 0.75 and 1 ms (80 W/m)."""
     plt = _plt()
     fig, axes = plt.subplots(1, 4, figsize=(15, 3.8))
-    shots = snapshots(os.path.join(sim_dir, "fountain_start_W80"), START_TIMES)
-    _field_panels(axes, shots, lambda pa, M: (pa.T - M.T0) * 1e3, "T - T0 [mK]", (-8.5, 8.5, -0.5, 17.5), "inferno")
-    fig.suptitle("Fig. 3.6: temperature in the cell, 80 W/m")
+    run = os.path.join(sim_dir, "fountain_start_W80")
+    shots = snapshots(run, START_TIMES)
+    _field_panels(axes, shots, lambda pa, M: (pa.T - M.T0) * 1e3, "T - T0 [mK]", (-8.5, 8.5, -0.5, 17.5), "inferno",
+                  run)
+    fig.suptitle("Fig. 3.6: temperature in the cell, 80 W/m" + state_suffix(run))
     _save(fig, out_dir, "fig3_6")
 
 
@@ -277,9 +287,11 @@ def fig3_7(sim_dir, out_dir, cfg):
     tf = PRESETS[cfg["fountain"]]["tf"]
     fig, axes = plt.subplots(1, len(cfg["powers"]), figsize=(4 * len(cfg["powers"]), 6))
     for ax, W in zip(np.atleast_1d(axes), cfg["powers"]):
-        shots = snapshots(os.path.join(sim_dir, f"fountain_W{W}"), (tf,))
-        _field_panels([ax], shots, lambda pa, M: np.hypot(pa.u, pa.v), "|v| [m/s]", (-25, 25, -10, 60), "viridis")
-        ax.set_title(f"{W} W/m, " + ax.get_title(), fontsize=8)
+        run = os.path.join(sim_dir, f"fountain_W{W}")
+        shots = snapshots(run, (tf,), upto_stop=False)            # a stopped run: its last state
+        _field_panels([ax], shots, lambda pa, M: np.hypot(pa.u, pa.v), "|v| [m/s]", (-25, 25, -10, 60), "viridis",
+                      run)
+        ax.set_title(f"{W} W/m{state_suffix(run)}, " + ax.get_title(), fontsize=8)
     fig.suptitle("Fig. 3.7: |v| at the end")
     _save(fig, out_dir, "fig3_7")
 
@@ -291,9 +303,11 @@ def fig3_8(sim_dir, out_dir, cfg):
     tf = PRESETS[cfg["fountain"]]["tf"]
     times = tuple(tf * (k + 1) / SNAPSHOTS for k in range(SNAPSHOTS))
     fig, axes = plt.subplots(2, SNAPSHOTS // 2, figsize=(16, 9))
-    shots = snapshots(os.path.join(sim_dir, "fountain_W80"), times)
-    _field_panels(axes.ravel(), shots, lambda pa, M: (pa.T - M.T0) * 1e3, "T - T0 [mK]", (-25, 25, -10, 60), "inferno")
-    fig.suptitle("Fig. 3.8: temperature and shape, 80 W/m")
+    run = os.path.join(sim_dir, "fountain_W80")
+    shots = snapshots(run, times)
+    _field_panels(axes.ravel(), shots, lambda pa, M: (pa.T - M.T0) * 1e3, "T - T0 [mK]", (-25, 25, -10, 60), "inferno",
+                  run)
+    fig.suptitle("Fig. 3.8: temperature and shape, 80 W/m" + state_suffix(run))
     _save(fig, out_dir, "fig3_8")
 
 

@@ -25,7 +25,11 @@ Snapshots are written at the figures' times (``--output-at``), so each panel is 
 ``python automate.py thermo`` runs the paper preset (levels as close to the paper's counts
 as the lattices allow; docs/thermo.md), ``python automate.py thermo_quick`` the quick one
 (coarsest levels; meant for under 30 minutes on 2 cores, docs/thermo.md says how this was
-estimated).  A figure whose runs are missing is drawn with "not run" panels.
+estimated).  A figure whose runs are missing is drawn with "not run" panels.  A run the
+blow-up guard stopped is drawn up to its stop, labelled "stopped at t = ..." (its panels after
+the stop say so); what only its results.json would give is None or left out, with a printed
+note, and the convergence and E-vs-eta measures that use its curves name it under ``stopped``
+(they compare over the common interval).
 ``python -m automation.thermo [outputs] [quick]`` redraws from finished runs.
 """
 import os
@@ -34,7 +38,8 @@ import sys
 import numpy as np
 
 from .superfluid import _json, _plt, _save
-from .tasks import SphgenProblem, Simulation, paper_and_quick
+from .tasks import (SphgenProblem, Simulation, paper_and_quick, pick, reached, read_results, run_info, run_state,
+                    state_suffix, state_text, stopped_marks)
 
 THIRD = repr(1.0 / 3.0)
 SIXTH = repr(1.0 / 6.0)
@@ -146,7 +151,7 @@ def probe_convergence(folders, columns):
     ``converging`` = the two finest closer than the two coarsest for every column."""
     from sphgen.applications._thermo_solid import relative_l2_in_time
     hs = [h for h in map(history, folders) if h is not None]
-    out = {"levels": len(hs)}
+    out = {"levels": len(hs), **_stopped(folders)}
     if len(hs) < 3:
         return out
     for col in columns:
@@ -161,7 +166,15 @@ def forms_gap(folder_E, folder_eta, columns):
     hE, hn = history(folder_E), history(folder_eta)
     if hE is None or hn is None:
         return None
-    return {col: relative_l2_in_time(hE["t"], hE[col], hn["t"], hn[col]) for col in columns}
+    return {**{col: relative_l2_in_time(hE["t"], hE[col], hn["t"], hn[col]) for col in columns},
+            **_stopped((folder_E, folder_eta))}
+
+
+def _stopped(folders):
+    """{"stopped": {run: t}} of the runs among ``folders`` the guard stopped, {} if none."""
+    got = {os.path.basename(os.path.normpath(f)): run_info(f).get("t") for f in folders
+           if run_state(f) == "stopped"}
+    return {"stopped": got} if got else {}
 
 
 def snapshots(folder, prefix, times):
@@ -181,9 +194,11 @@ def snapshots(folder, prefix, times):
     return out
 
 
-def _not_run(ax, title=""):
-    ax.text2D(0.5, 0.5, "not run", ha="center", transform=ax.transAxes) if hasattr(ax, "text2D") else \
-        ax.text(0.5, 0.5, "not run", ha="center", transform=ax.transAxes)
+def _not_run(ax, title="", run=None):
+    """An empty panel: "not run", or "stopped at t = ..." for a run the guard stopped."""
+    text = "not run" if run is None else state_text(run)
+    ax.text2D(0.5, 0.5, text, ha="center", transform=ax.transAxes) if hasattr(ax, "text2D") else \
+        ax.text(0.5, 0.5, text, ha="center", transform=ax.transAxes)
     ax.set_title(title, fontsize=8)
 
 
@@ -219,11 +234,11 @@ def snapshot_figure(out_dir, name, rows, suptitle, view=(25, -60)):
         for j, t in enumerate(times):
             ax = fig.add_subplot(len(rows), ncol, i * ncol + j + 1, projection="3d")
             hit = shots[t]
-            if hit is None:
-                _not_run(ax, f"{label}, t = {t:g} s")
+            if hit is None or not reached(folder, t, hit[1]):
+                _not_run(ax, f"{label}, t = {t:g} s", folder)      # none, or after the stop
                 continue
             pa, t_file = hit
-            scatter3d(fig, ax, pa, field, f"{label}, t = {t_file:.4g} s", view)
+            scatter3d(fig, ax, pa, field, f"{label}, t = {t_file:.4g} s{state_suffix(folder)}", view)
             shown[f"{label} {field} {t:g}"] = {"t": t_file, "min": float(_field(pa, field).min()),
                                                "max": float(_field(pa, field).max())}
     fig.suptitle(suptitle, fontsize=10)
@@ -243,7 +258,7 @@ def series_figure(out_dir, name, runs, panels, suptitle):
             if h is None:
                 continue
             for col, comp in cols:
-                ax.plot(h["t"], h[col], style, lw=1, label=f"{comp} {label}".strip())
+                ax.plot(h["t"], h[col], style, lw=1, label=f"{comp} {label}".strip() + state_suffix(folder))
         if ax.lines:
             ax.legend(fontsize=6)
         else:
@@ -324,12 +339,13 @@ def ablation_figure(out_dir, name, runs, suptitle, free_from=0.0):
         A = np.stack([h["A_x"], h["A_y"], h["A_z"]], 1)
         k = min(int(np.searchsorted(h["t"], free_from - 1e-12)), len(h["t"]) - 1)
         drift = np.linalg.norm(A - A[k], axis=1) / max(np.linalg.norm(A[k]), 1e-300)
-        axes[0].plot(h["t"], h["kinetic"], lw=1, label=label)
-        axes[1].plot(h["t"], h["entropy"] - h["entropy"][0], lw=1, label=label)
-        axes[2].semilogy(h["t"][k:], np.maximum(drift[k:], 1e-17), lw=1, label=label)
-        r = _json(folder, "results.json") or {}
-        data[label] = {key: r.get(key) for key in ("t", "n_particles", "J_min", "energy_residual", "L_drift",
-                                                   "A_drift", "entropy_fall", "entropy_rise", "theta_range")}
+        shown = label + state_suffix(folder)
+        axes[0].plot(h["t"], h["kinetic"], lw=1, label=shown)
+        axes[1].plot(h["t"], h["entropy"] - h["entropy"][0], lw=1, label=shown)
+        axes[2].semilogy(h["t"][k:], np.maximum(drift[k:], 1e-17), lw=1, label=shown)
+        data[label] = pick(folder, read_results(folder, "its checks (ablation)"),
+                           ("t", "n_particles", "J_min", "energy_residual", "L_drift", "A_drift", "entropy_fall",
+                            "entropy_rise", "theta_range"))
         data[label]["A_drift_end"] = float(drift[-1])
     for ax, ylabel in zip(axes, ("K [J]", "S - S(0) [J/K]", f"|A - A({free_from:g})| / |A({free_from:g})|")):
         ax.set_xlabel("t [s]")
@@ -411,17 +427,18 @@ def fig3(sim_dir, out_dir, cfg):
     comps = (("p_x", "p_y", "p_z"), ("P_11", "P_12", "P_22", "P_23", "P_33"), ("theta",))
     data = {}
     for (jumps, bc), style in zip(cfg["mms_cases"], ("o-", "s--", "^-.", "v:")):
-        rows = [r for n in cfg["mms_n"]
-                if (r := _json(os.path.join(sim_dir, f"mms_{jumps}_{bc}_n{n}"), "results.json"))]
+        runs = {f"n = {n}": os.path.join(sim_dir, f"mms_{jumps}_{bc}_n{n}") for n in cfg["mms_n"]}
+        rows = [r for run in runs.values() if (r := read_results(run, "its L2 errors (Fig. 3)"))]
         if not rows:
             continue
         key = f"{jumps}, {bc}"
         data[key] = {"dx": [r["dx"] for r in rows], "orders": orders(rows, "inner") if len(rows) >= 3 else {},
-                     "errors": {c: [r.get(f"inner_{c}") for r in rows] for group in comps for c in group}}
+                     "errors": {c: [r.get(f"inner_{c}") for r in rows] for group in comps for c in group},
+                     **_stopped(runs.values())}          # a stopped level has no errors: left out
         for ax, group in zip(axes, comps):
             for c in group:
                 e = data[key]["errors"][c]
-                ax.loglog(data[key]["dx"], e, style, ms=4, lw=1, label=f"{c} ({key})")
+                ax.loglog(data[key]["dx"], e, style, ms=4, lw=1, label=f"{c} ({key}){stopped_marks(runs)}")
     for ax, what in zip(axes, ("(a) linear momentum", "(b) first Piola-Kirchhoff stress", "(c) temperature")):
         if ax.lines:
             dx = np.array(sorted({d for v in data.values() for d in v["dx"]}))
@@ -566,7 +583,7 @@ def punch_figures(sim_dir, out_dir, cfg):
                                         "theta (top view)"),
                                        (run("full", "E", mid), "thermo_punch", "p", PUNCH_TIMES["fig19"], "p")],
                     f"Fig. 19: full scheme, dx = {_dx_label(mid)}")
-    res = {v: _json(run(v, "E", mid), "results.json") for v in ("full", "reduced")}
+    res = {v: read_results(run(v, "E", mid), "its R_p") for v in ("full", "reduced")}
     out["R_p"] = {v: {k: s["R_p"] for k, s in r.get("snapshots", {}).items()} for v, r in res.items() if r}
     out["ablation"] = ablation_figure(out_dir, "ablation_punch",
                                       [("default (raw jumps)", run("full", "E", mid)),
@@ -589,9 +606,9 @@ def gripper_figures(sim_dir, out_dir, cfg):
         for j, (view, name) in enumerate((((25, -60), "isometric"), ((0, -90), "front"), ((90, -90), "top"))):
             ax = fig.add_subplot(2, 3, 3 * i + j + 1, projection="3d")
             if shots[0.47] is None:
-                _not_run(ax, name)
+                _not_run(ax, name, fine)
             else:
-                scatter3d(fig, ax, shots[0.47][0], f, f"{name}, t = {shots[0.47][1]:.4g} s", view)
+                scatter3d(fig, ax, shots[0.47][0], f, f"{name}, t = {shots[0.47][1]:.4g} s{state_suffix(fine)}", view)
     fig.suptitle(f"Fig. 21: gripper at 0.47 s, dx = {_dx_label(levels[-1])}", fontsize=9)
     _save(fig, out_dir, "fig21")
     series_figure(out_dir, "fig22", [(f"dx={_dx_label(dx)}", os.path.join(sim_dir, f"gripper_dx{_dx_label(dx)}"),

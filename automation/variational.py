@@ -18,7 +18,7 @@ import os
 
 import numpy as np
 
-from .tasks import SphgenProblem, Simulation
+from .tasks import SphgenProblem, Simulation, pick, run_info, run_state, state_suffix, stopped_at, stopped_marks
 
 SNAPSHOTS = (0.10, 0.25, 0.50, 1.00)
 """Snapshot times of Figs. 2 and 3 (not printed in the paper; the project's digest of the paper, section 6)."""
@@ -67,8 +67,9 @@ class VariationalDamBreak(SphgenProblem):
             counts = []
             for ax, t in zip(axes.ravel(), SNAPSHOTS):
                 path = files.get(round(t, 9))
-                if path is None:
+                if path is None:               # a stopped run has no file after its stop
                     counts.append(None)
+                    ax.set_title(f"t = {t:.2f} s: {stopped_at(folder) or 'no output'}", fontsize=9)
                     continue
                 _, x, y = positions(path)
                 out = ejected(x, y)
@@ -79,7 +80,8 @@ class VariationalDamBreak(SphgenProblem):
                 ax.set_aspect("equal")
                 ax.set_xlim(-0.01, 0.59)
                 ax.set_ylim(-0.01, 0.30)
-            f.suptitle(f"dam break, {label} ({'alpha = 0.5' if label == 'implicit' else 'leapfrog, eqs. 59-62'})")
+            f.suptitle(f"dam break, {label} ({'alpha = 0.5' if label == 'implicit' else 'leapfrog, eqs. 59-62'})"
+                       + state_suffix(folder))
             f.tight_layout()
             f.savefig(self.output_path(fig), dpi=130)
             plt.close(f)
@@ -87,8 +89,9 @@ class VariationalDamBreak(SphgenProblem):
         t, D = scheme_difference(imp, exp)
         tc, Dc = scheme_difference(cen, exp)
         f, (a1, a2) = plt.subplots(1, 2, figsize=(9, 3.6))
-        a1.plot(t, D, "k-", label="implicit - explicit (eq. 70)")
-        a1.plot(tc, Dc, "b--", lw=0.8, label="implicit, centred density - explicit")
+        a1.plot(t, D, "k-", label="implicit - explicit (eq. 70)" + state_suffix(imp) + state_suffix(exp))
+        a1.plot(tc, Dc, "b--", lw=0.8, label="implicit, centred density - explicit" + state_suffix(cen)
+                + state_suffix(exp))
         a1.legend(fontsize=8)
         a2.semilogy(t[D > 0], D[D > 0], "k-")
         a2.semilogy(tc[Dc > 0], Dc[Dc > 0], "b--", lw=0.8)
@@ -98,24 +101,25 @@ class VariationalDamBreak(SphgenProblem):
         f.tight_layout()
         f.savefig(self.output_path("variational_fig4_D.png"), dpi=130)
         plt.close(f)
-        quarters = [float(D[(t > a) & (t <= b)].max()) for a, b in ((0, .25), (.25, .5), (.5, .75), (.75, 1.0))]
-        summary["D"] = {"final": float(D[-1]), "max_per_quarter_second": quarters,
-                        "at_snapshots": [float(D[np.argmin(abs(t - s))]) for s in SNAPSHOTS]}
-        summary["D_centred_vs_explicit"] = {"final": float(Dc[-1]),
-                                            "at_snapshots": [float(Dc[np.argmin(abs(tc - s))]) for s in SNAPSHOTS]}
+        quarters = [_window_max(t, D, a, b) for a, b in ((0, .25), (.25, .5), (.5, .75), (.75, 1.0))]
+        summary["D"] = {"final": _last(D), "t_final": _last(t), "max_per_quarter_second": quarters,
+                        "at_snapshots": [_at(t, D, s) for s in SNAPSHOTS]}
+        summary["D_centred_vs_explicit"] = {"final": _last(Dc), "t_final": _last(tc),
+                                            "at_snapshots": [_at(tc, Dc, s) for s in SNAPSHOTS]}
         f, ax = plt.subplots(figsize=(6, 4))
         for label, case, style in (("implicit", self.cases[0], "k-"), ("explicit", self.cases[1], "r-"),
                                    ("implicit_centred", self.cases[2], "b--")):
             h = self.history(case)
             rows = np.array(h["rows"], dtype=float)
             c = {k: rows[:, i] for i, k in enumerate(h["columns"])}
-            ax.plot(c["t"], c["Q"], style, label=label)
+            ax.plot(c["t"], c["Q"], style, label=label + state_suffix(case))
             late = (c["t"] >= 0.8) & (c["t"] <= 1.0)
             summary[f"Q_{label}"] = {"max": float(c["Q"].max()), "t_max": float(c["t"][np.argmax(c["Q"])]),
                                      "final": float(c["Q"][-1]),
                                      "mean_0.8_1.0": float(c["Q"][late].mean()) if late.any() else None,
                                      "min_0.8_1.0": float(c["Q"][late].min()) if late.any() else None,
                                      "local_maxima": _local_maxima(c["t"], c["Q"])}
+            summary[f"Q_{label}"].update(pick(case, None, ()))       # stopped_at, for a stopped run
             summary[f"results_{label}"] = self.results(case)
         ax.set_xlabel("t (s)")
         ax.set_ylabel("Q = |sum m v| / M (m/s)")
@@ -170,7 +174,7 @@ class VariationalEjection(SphgenProblem):
         f, axes = plt.subplots(len(self.cases), 2, figsize=(9, 2.3 * len(self.cases)), sharex=True, sharey=True)
         for row, case in zip(axes, self.cases):
             name = os.path.basename(case.input_path())
-            if not os.path.exists(case.input_path("results.json")):
+            if run_state(case) == "not run":
                 print(f"{name:18s} not run")
                 continue
             files = outputs_by_time(case.input_path())
@@ -185,8 +189,7 @@ class VariationalEjection(SphgenProblem):
                 rec["quarter_median"].append(int(ejected(x, y).sum()))
                 rec["digest"].append(int((count_neighbours((x, y), 2.0 * DX) < 4).sum()))
                 rec["y_max"].append(float(y.max()))
-            r = self.results(case)
-            rec.update({k: r.get(k) for k in ("rho_min", "rho_max", "Q_max", "t")})
+            rec.update(pick(case, self.results(case), ("rho_min", "rho_max", "Q_max", "t")))
             out[name] = rec
             shown = [t for t in (0.25, 0.50) if files.get(round(t, 9))]
             for ax, t in zip(row, shown):
@@ -194,9 +197,10 @@ class VariationalEjection(SphgenProblem):
                 e = ejected(x, y)
                 ax.plot(x[~e], y[~e], ".", ms=1, color="tab:blue")
                 ax.plot(x[e], y[e], ".", ms=3, color="tab:red")
-                ax.set_title(f"{name}, t = {t:.2f} s ({int(e.sum())} ejected)", fontsize=8)
+                ax.set_title(f"{name}{state_suffix(case)}, t = {t:.2f} s ({int(e.sum())} ejected)", fontsize=8)
                 ax.set_aspect("equal")
-            print(f"{name:18s} ejected (1/4 median) {rec['quarter_median']}  (<=2 nbrs in 2dx) {rec['digest']}")
+            print(f"{name:18s} ejected (1/4 median) {rec['quarter_median']}  (<=2 nbrs in 2dx) {rec['digest']}"
+                  f"{state_suffix(case)}")
         f.tight_layout()
         f.savefig(self.output_path("variational_ejection.png"), dpi=110)
         plt.close(f)
@@ -211,6 +215,34 @@ def _local_maxima(t, q, smooth=5):
     s = np.convolve(q, np.ones(smooth) / smooth, mode="same")
     i = [k for k in range(smooth, s.size - smooth) if s[k] >= s[k - 1] and s[k] > s[k + 1]]
     return [[float(t[k]), float(s[k])] for k in i]
+
+
+def _last(y):
+    """The last sample of ``y``, or None if it has none."""
+    return float(y[-1]) if len(y) else None
+
+
+def _window_max(t, y, a, b):
+    """The largest ``y`` over a < t <= b, or None if no sample falls there (a run stopped before a)."""
+    inside = (t > a) & (t <= b)
+    return float(y[inside].max()) if inside.any() else None
+
+
+def _at(t, y, s, tol=1e-9):
+    """``y`` at the sample nearest to time ``s``, or None if ``s`` is past the last sample."""
+    if not len(t) or s > t[-1] + tol:
+        return None
+    return float(y[np.argmin(abs(t - s))])
+
+
+def _error(results, key):
+    """results[key], or NaN when the run has no results.json (stopped, or did not end)."""
+    return float("nan") if results is None else float(results[key])
+
+
+def _finite(values):
+    """A list for JSON: NaN as None."""
+    return [None if np.isnan(v) else float(v) for v in values]
 
 
 def _rows(case):
@@ -256,10 +288,14 @@ class VariationalOrder(SphgenProblem):
         f, ax = plt.subplots(figsize=(6, 4.5))
         out = {"tf": self.tf, "dt": list(self.dts), "reference_dt": self.dts[-1] / self.refine, "series": {}}
         for (name, density), runs in self.groups.items():
-            e = np.array([self.results(c)["position_error_max"] for c in runs])
+            e = np.array([_error(self.results(c, "its position error"), "position_error_max") for c in runs])
             slopes = np.diff(np.log(e)) / np.diff(np.log(self.dts))
-            out["series"][f"{name}_{density}"] = {"error_max": e.tolist(), "slopes": slopes.tolist()}
-            ax.loglog(self.dts, e, "o-", label=f"{name}, {density} density")
+            stopped = {f"dt{dt:g}": run_info(c).get("t") for dt, c in zip(self.dts, runs)
+                       if run_state(c) == "stopped"}
+            out["series"][f"{name}_{density}"] = {"error_max": _finite(e), "slopes": _finite(slopes),
+                                                  "stopped_at": stopped}
+            ax.loglog(self.dts, e, "o-", label=f"{name}, {density} density"
+                      + stopped_marks({f"dt{dt:g}": c for dt, c in zip(self.dts, runs)}))
             print(f"{name:9s} {density:10s} errors {' '.join(f'{v:.3e}' for v in e)}  "
                   f"slopes {' '.join(f'{s:.2f}' for s in slopes)}")
         d = np.array(self.dts)
@@ -301,12 +337,12 @@ class VariationalEnergy(SphgenProblem):
             c = _rows(case)
             rel = c["energy"] / c["energy"][0] - 1.0
             name = os.path.basename(case.input_path())
-            ax.plot(c["t"], rel, label=name.split("_")[0], lw=0.8)
+            ax.plot(c["t"], rel, label=name.split("_")[0] + state_suffix(case), lw=0.8)
             ax.set_title(f"{name.split('_')[1]} density")
-            r = self.results(case)
-            out[name] = {k: r.get(k) for k in ("energy_error", "energy_final", "energy_mean_second_half",
-                                               "iterations_mean", "iterations_max", "contraction_max",
-                                               "evaluations", "momentum_max")}
+            r = self.results(case) or {}
+            out[name] = pick(case, r, ("energy_error", "energy_final", "energy_mean_second_half",
+                                       "iterations_mean", "iterations_max", "contraction_max",
+                                       "evaluations", "momentum_max"))
             out[name]["steps"] = int(round(r["t"] / self.dt)) if r.get("t") is not None else None
         for ax in axes:
             ax.set_xlabel("t (s)")

@@ -1,4 +1,7 @@
-"""Shared fixtures: small jittered particle clouds and compiled-vs-Python runners."""
+"""Shared fixtures: small jittered particle clouds, compiled-vs-Python runners, and the texts
+of the figures a test draws."""
+import os
+
 import numpy as np
 import pytest
 
@@ -50,3 +53,20 @@ def march(integ, dt, steps, t=0.0):
         integ.one_timestep(t, dt)
         t += dt
     return t
+
+
+@pytest.fixture
+def figure_texts(monkeypatch):
+    """{file name: every text (titles, legend entries, labels) of each matplotlib figure saved
+    during the test, joined by " | "}."""
+    from matplotlib.figure import Figure
+    from matplotlib.text import Text
+    saved, savefig = {}, Figure.savefig
+
+    def record(fig, fname, *args, **kwargs):
+        saved[os.path.basename(os.fspath(fname))] = " | ".join(t.get_text() for t in fig.findobj(Text)
+                                                               if t.get_text())
+        return savefig(fig, fname, *args, **kwargs)
+
+    monkeypatch.setattr(Figure, "savefig", record)
+    return saved

@@ -195,3 +195,43 @@ def test_every_figure_from_finished_and_from_missing_runs(tmp_path):
     shtc.figures(str(tmp_path / "nothing"), str(empty), cfg)
     for name in FIGURES:
         assert os.path.getsize(empty / name / f"{name}.png") > 0, name
+
+
+def _stop(folder, t):
+    """Turn a fake finished run into one the blow-up guard stopped at ``t``: no results.json."""
+    os.remove(os.path.join(folder, "results.json"))
+    with open(os.path.join(folder, "info.json"), "w") as f:
+        json.dump({"completed": False, "stopped": True, "error": "speed above the limit", "t": t}, f)
+
+
+@pytest.mark.filterwarnings("ignore")
+def test_stopped_runs_are_drawn_up_to_the_stop_and_labelled(tmp_path, figure_texts, capsys):
+    cfg = CONFIG["quick"]
+    sim, out = tmp_path / "outputs", tmp_path / "figures"
+    _fake_runs(sim, cfg)
+    re400 = cavity_name(*cfg["cavity"][1][:2])
+    for name, t in (("plate_cp10", 3e-5), ("couette", 10.0), (re400, 7.5), ("dam_break", 0.6),
+                    ("reversibility", 0.01), ("column", 0.1)):
+        _stop(str(sim / name), t)
+    os.remove(sim / "column" / "twisting_column_000002.h5")      # its file at t = 0.2: after the stop
+    got = shtc.figures(str(sim), str(out), cfg)
+    for name in FIGURES:
+        assert os.path.getsize(out / name / f"{name}.png") > 0, name
+    assert got["plate"]["plate_cp10"] == {"stopped_at": 3e-5} and got["plate"]["plate_cp0"]["torn"] is True
+    assert "SHTC-SPH (sphgen) (stopped at t = 3e-05)" in figure_texts["P_fig2.png"]
+    assert "c_p = 10 c0, t = 3e-05 s (stopped at t = 3e-05)" in figure_texts["P_fig4.png"]
+    assert "stopped at t = 10" in figure_texts["P_fig8.png"] and "(stopped at t = 10)" in figure_texts["P_fig9.png"]
+    assert got["couette"] == {"stopped_at": 10.0} and got["column"] == {"stopped_at": 0.1}
+    p5 = figure_texts["P_fig5.png"]        # 0.05 and 0.1 drawn; 0.15 and 0.2 after the stop
+    assert p5.count("| stopped at t = 0.1 |") == 2 and "t = 0.1 s" in p5 and "(stopped at t = 0.1)" in p5
+    with open(out / "T_fig2_6" / "T_fig2_6.json") as f:
+        centre = json.load(f)
+    assert centre["Re400"]["stopped_at"] == 7.5 and centre["Re400"]["ghia_error"] is None
+    assert centre["Re100"]["ghia_error"] == 0.04
+    assert "stopped at t = 7.5" in figure_texts["T_fig2_6.png"]
+    assert "dam_break (stopped at t = 0.6)" in figure_texts["T_fig1_3.png"]
+    assert got["dam_break"]["stopped_at"] == 0.6 and got["dam_break"]["toe_max_rel_dev_violeau"] is None
+    assert got["thesis"]["P_sec3_6_reversibility"] == {"stopped_at": 0.01}
+    notes = capsys.readouterr().out
+    for name in ("plate_cp10", "couette", re400, "dam_break"):
+        assert f"note: {name} stopped at t = " in notes, name

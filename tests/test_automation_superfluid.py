@@ -67,3 +67,36 @@ def test_figures_from_finished_runs(tmp_path):
     assert set(s["fig3_5"]) == {60, 80}
     for k in range(1, 9):
         assert os.path.getsize(out / f"fig3_{k}" / f"fig3_{k}.png") > 5000, k
+
+
+def _stop(folder, t):
+    """The blow-up guard stopped this fake run at ``t``: no results.json."""
+    os.remove(os.path.join(folder, "results.json"))
+    with open(os.path.join(folder, "info.json"), "w") as f:
+        json.dump({"completed": False, "stopped": True, "t": t}, f)
+
+
+def test_figures_with_stopped_runs(tmp_path, figure_texts, capsys):
+    cfg = dict(CONFIG["quick"], N=(25, 50), A=(0.01, 0.1), Ms=(10, 25), fountain="quick")
+    sim, out = tmp_path / "sim", tmp_path / "fig"
+    for name, p in second_sound_cases(cfg).items():
+        _fake_second_sound(sim / name, p["N"], p["A"], p["M"])
+    _fake_fountain(sim / "fountain_W80", 80, [0.015 * (k + 1) for k in range(8)])
+    _fake_fountain(sim / "fountain_W60", 60, [0.03])
+    _fake_fountain(sim / "fountain_start_W80", 80, START_TIMES[:2])
+    _stop(str(sim / "fountain_start_W80"), START_TIMES[1])
+    _stop(str(sim / ss_name(25, 0.1, 50)), 2e-4)
+    _stop(str(sim / ss_name(50, 0.01, 50)), 3e-4)         # also Fig. 3.3's run
+    _stop(str(sim / "fountain_W60"), 0.03)
+    s = figures(str(sim), str(out), cfg)
+    assert s["fig3_2"]["entropy_error"]["25"] == [[0.01, pytest.approx(0.014)]]
+    assert set(s["fig3_5"]) == {80}
+    assert "N = 25 (A = 0.1 stopped at t = 0.0002)" in figure_texts["fig3_2.png"]
+    assert "sphgen (stopped at t = 0.0003)" in figure_texts["fig3_3.png"]
+    assert "jet speed (60 W/m stopped at t = 0.03)" in figure_texts["fig3_5.png"]
+    assert "60 W/m (stopped at t = 0.03)" in figure_texts["fig3_7.png"]
+    fig3_6 = figure_texts["fig3_6.png"]              # 0.75 and 1 ms: after the stop
+    assert fig3_6.count("| stopped at t = 0.0005 |") == 2 and "80 W/m (stopped at t = 0.0005)" in fig3_6
+    notes = capsys.readouterr().out
+    assert f"note: {ss_name(25, 0.1, 50)} stopped at t = 0.0002: its entropy error (Fig. 3.2) missing" in notes
+    assert "note: fountain_W60 stopped at t = 0.03: its flux series (Fig. 3.5) missing" in notes

@@ -165,3 +165,37 @@ def test_every_figure_from_finished_runs(tmp_path):
     assert shown["theta theta 25"]["t"] == 25.0     # the panel is at its time (--output-at)
     with open(out / "fig5" / "fig5.json") as f:
         assert "dx = 1 p 7.7" not in json.load(f)  # the missing level is not drawn
+
+
+def _stop(folder, t):
+    """The blow-up guard stopped this fake run at ``t``: no results.json."""
+    os.remove(os.path.join(folder, "results.json"))
+    with open(os.path.join(folder, "info.json"), "w") as f:
+        json.dump({"completed": False, "stopped": True, "t": t}, f)
+
+
+@pytest.mark.filterwarnings("ignore")
+def test_disk_figures_with_stopped_runs(tmp_path, figure_texts, capsys):
+    """The finest E-form level stopped at t = 2.5 (its snapshots after the stop say so) and an
+    ablation stopped: drawn, labelled, their results None, named in the convergence measures."""
+    from sphgen import io
+    cfg = CONFIG["quick"]
+    sim, out = tmp_path / "sim", tmp_path / "fig"
+    fine = f"disk_E_dx{thermo._dx_label(cfg['disk_dx'][-1])}"
+    for name, (app, args) in thermo.disk_cases(cfg).items():
+        _fake(sim, name, app, times=thermo._times(DISK_TIMES) if "ablation" not in name else (),
+              tf=2.5 if name == fine else 10.0, err=float(args[1]) ** 2)
+    for path in io.output_files(str(sim / fine)):          # the stopped run wrote nothing after t = 2.5
+        if io.read_solver_data(path)["t"] > 2.5:
+            os.remove(path)
+    _stop(str(sim / fine), 2.5)
+    _stop(str(sim / "disk_ablation_raw"), 10.0)
+    di = thermo.disk_figures(str(sim), str(out), cfg)
+    assert di["ablation"]["raw jumps"]["stopped_at"] == 10.0 and di["ablation"]["raw jumps"]["J_min"] is None
+    assert di["fig12"]["convergence"]["E"]["stopped"] == {fine: 2.5}
+    assert "stopped" not in di["fig12"]["convergence"]["eta"]
+    assert f"E dx={thermo._dx_label(cfg['disk_dx'][-1])} (stopped at t = 2.5)" in figure_texts["fig12.png"]
+    assert "raw jumps (stopped at t = 10)" in figure_texts["ablation_disk.png"]
+    fig14 = figure_texts["fig14.png"]
+    assert "(stopped at t = 2.5)" in fig14 and "| stopped at t = 2.5 |" in fig14   # a title; an empty panel
+    assert "note: disk_ablation_raw stopped at t = 10: its checks (ablation) missing" in capsys.readouterr().out
