@@ -230,7 +230,7 @@ def test_others_running_reads_the_runnable_count(tmp_path):
 
 @pytest.mark.parametrize("backend, nx", [("cython", "100"), ("python", "16")])
 def test_snapshot_restores_every_array_bit_for_bit(tmp_path, backend, nx):
-    """The guard's snapshot (one byte buffer, copied by the backend in parallel pieces)
+    """The guard's snapshot (one byte buffer; each thread copies its part of every array)
     brings back every property of every array, integers included, and the time."""
     App = load_application("taylor_green")
     kept = {}
@@ -257,3 +257,13 @@ def test_snapshot_restores_every_array_bit_for_bit(tmp_path, backend, nx):
             np.testing.assert_array_equal(v, before[(pa.name, k)], err_msg=f"{pa.name}.{k}")
     assert any(v.dtype.kind in "iu" for v in before.values())
     assert max(v.nbytes for v in before.values()) > 65536 or backend == "python"   # pieces
+
+    # the speed check: each thread scans its part, then the parts' maxima are compared
+    fluid = solver.scene.by_name["fluid"]
+    rng = np.random.default_rng(3)
+    for where in (0, fluid.n // 2 - 1, fluid.n // 2, fluid.n - 1):
+        fluid.u[:] = rng.uniform(-1, 1, fluid.n)
+        fluid.v[:] = rng.uniform(-1, 1, fluid.n)
+        fluid.u[where], fluid.v[where] = 3.0, -2.0
+        ((name, speed2, i),) = solver.scene.max_speed2()
+        assert (name, i) == ("fluid", where) and speed2 == 13.0

@@ -9,8 +9,6 @@ from dataclasses import dataclass
 
 from mako.template import Template
 
-from ..nnps._cell_list import SERIAL_BELOW
-
 from . import pair_symbols
 from .cython import to_cython
 from .pair_symbols import CythonPair
@@ -192,7 +190,7 @@ def render(plan):
         kernel_code=[to_cython(sp) for sp in plan.kernel_functions],
         helper_code=[to_cython(sp) for sp in plan.helpers],
         method_code=[_method_code(fp) for fp in plan.functions],
-        passes=passes, stages=stages, serial_below=SERIAL_BELOW, **_array_tables(plan))
+        passes=passes, stages=stages, **_array_tables(plan))
     return Rendered(
         source=source, parameters=dict(plan.parameters),
         pass_entries={p.name: f"pass_{p.name}" for p in passes},

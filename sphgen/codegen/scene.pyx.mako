@@ -115,10 +115,12 @@ def pass_${p.name}(double t, double dt):
 % for s in stages:
 def stage_${s.name}(double t, double dt):
     cdef long d_idx
-    # a stage is a few flops per particle: threads only pay off for large arrays
-    cdef int nt = _nthreads if ${s.array}_n > 20000 else 1
+    # static halves, as the passes over this array: each thread updates the particles whose
+    # rates it computed, so no particle's data moves between cores (a serial stage costs
+    # 13x more on the dam break on two threads than serially: every line it reads is in the
+    # other core's cache)
     with nogil:
-        for d_idx in prange(${s.array}_n, num_threads=nt, schedule='static'):
+        for d_idx in prange(${s.array}_n, num_threads=_nthreads, schedule='static'):
             ${s.call}
 
 % endfor
@@ -133,8 +135,7 @@ def count_nonfinite():
 % for arr, props in guarded:
 % for stride in sorted(set(st for _, st in props)):
     with nogil:
-        for i in prange(${arr}_n * ${stride}, num_threads=_nthreads if ${arr}_n * ${stride} > ${serial_below} else 1,
-                        schedule='static'):
+        for i in prange(${arr}_n * ${stride}, num_threads=_nthreads, schedule='static'):
             bad += ${" + ".join(f"(not isfinite({arr}_{p}[i]))" for p, st in props if st == stride)}
 % endfor
 % endfor
@@ -162,59 +163,71 @@ def _count_nonfinite_each():
 
 
 def max_speed2():
-    """[(array, largest |u|^2, its particle)] for the arrays with velocities."""
-    cdef long i, im
-    cdef double m, s2
+    """[(array, largest |u|^2, its particle)] for the arrays with velocities; thread k scans
+    the k-th of ``_nthreads`` equal parts (the particles it updates), then the parts' maxima
+    are compared."""
+    cdef long i, k, lo, hi
+    cdef long[64] at
+    cdef double[64] best
+    cdef double s2
+    cdef int nt = min(_nthreads, 64)
     out = []
 % for arr, speed2 in moving:
-    m = 0.0
-    im = -1
     with nogil:
-        for i in range(${arr}_n):
-            s2 = ${speed2}
-            if s2 > m:
-                m = s2
-                im = i
-    out.append(('${arr}', m, im))
+        for k in prange(nt, num_threads=nt, schedule='static'):
+            lo = ${arr}_n * k // nt
+            hi = ${arr}_n * (k + 1) // nt
+            best[k] = 0.0
+            at[k] = -1
+            for i in range(lo, hi):
+                s2 = ${speed2}
+                if s2 > best[k]:
+                    best[k] = s2
+                    at[k] = i
+    for k in range(1, nt):
+        if best[k] > best[0]:
+            best[0] = best[k]
+            at[0] = at[k]
+    out.append(('${arr}', best[0], at[0]))
 % endfor
     return out
 
 
 def copy_arrays(list arrays, cnp.ndarray out, bint save):
     """The guard's snapshot: the bytes of every array, one after the other, into ``out``
-    (``save``) or back from it; threaded over pieces of at most 64 KiB."""
-    cdef Py_ssize_t piece = 65536, nseg = 0, total = 0, nb, off, k
-    cdef Py_ssize_t cap = len(arrays) + out.nbytes // piece + 1
+    (``save``) or back from it.  Thread k copies the k-th of ``_nthreads`` equal parts of
+    every array: the part whose particles it updates in the static passes and stages, so
+    the copy reads (and a restore writes) what is already in its own core's cache."""
+    cdef Py_ssize_t narr = len(arrays), total = 0, nb, j, k, lo, hi
+    cdef int nt = _nthreads
     cdef char* base = <char*>cnp.PyArray_DATA(out)
-    cdef char* p
-    cdef char** where = <char**>malloc(cap * sizeof(char*))
-    cdef Py_ssize_t* at = <Py_ssize_t*>malloc(cap * sizeof(Py_ssize_t))
-    cdef Py_ssize_t* size = <Py_ssize_t*>malloc(cap * sizeof(Py_ssize_t))
+    cdef char** where = <char**>malloc((narr + 1) * sizeof(char*))
+    cdef Py_ssize_t* at = <Py_ssize_t*>malloc((narr + 1) * sizeof(Py_ssize_t))
+    cdef Py_ssize_t* size = <Py_ssize_t*>malloc((narr + 1) * sizeof(Py_ssize_t))
     if where == NULL or at == NULL or size == NULL:
         free(where); free(at); free(size)
         raise MemoryError("copy_arrays")
     try:
-        for a in arrays:
+        for j, a in enumerate(arrays):
             if not (<cnp.ndarray>a).flags['C_CONTIGUOUS']:
                 raise TypeError("copy_arrays: needs C-contiguous arrays")
             nb = (<cnp.ndarray>a).nbytes
             if total + nb > out.nbytes:
                 raise ValueError("copy_arrays: the buffer is too small")
-            p = <char*>cnp.PyArray_DATA(<cnp.ndarray>a)
-            off = 0
-            while off < nb:
-                where[nseg] = p + off
-                at[nseg] = total + off
-                size[nseg] = min(piece, nb - off)
-                nseg += 1
-                off += piece
+            where[j] = <char*>cnp.PyArray_DATA(<cnp.ndarray>a)
+            at[j] = total
+            size[j] = nb
             total += nb
-        with nogil:  # below 1 MiB one thread copies faster than two start and join
-            for k in prange(nseg, num_threads=_nthreads if total > 1048576 else 1, schedule='dynamic'):
-                if save:
-                    memcpy(base + at[k], where[k], size[k])
-                else:
-                    memcpy(where[k], base + at[k], size[k])
+        with nogil:
+            for k in prange(nt, num_threads=nt, schedule='static'):
+                for j in range(narr):
+                    lo = (size[j] * k // nt) // 64 * 64        # part k, on cache-line bounds
+                    hi = size[j] if k == nt - 1 else (size[j] * (k + 1) // nt) // 64 * 64
+                    if hi > lo:
+                        if save:
+                            memcpy(base + at[j] + lo, where[j] + lo, hi - lo)
+                        else:
+                            memcpy(where[j] + lo, base + at[j] + lo, hi - lo)
     finally:
         free(where)
         free(at)

@@ -51,7 +51,6 @@ cdef Py_ssize_t _SHORT_ROW = 48
 # region's start and join (a few microseconds) cost more than the loop (dam break,
 # 3 384 particles: gathering the source records took 3.4 us serially, 4.8 us on 2 threads)
 cdef Py_ssize_t _SERIAL_BELOW = 16384
-SERIAL_BELOW = _SERIAL_BELOW     # the generated modules' small loops follow the same rule
 
 
 ctypedef struct Grid:
@@ -993,8 +992,11 @@ def refine_rows(GridSpec grid, int[::1] offsets, int[::1] nbrs, list dest_coords
             ends[i] = <int>(offsets[i] + cnt)
             total += cnt
         return total
-    for i in prange(nd, nogil=True, schedule="dynamic", chunksize=64):  # rows of a wall list
-        kh = radius_scale * dest_h[i]                                     # vary from 0 to full
+    # static halves, as the passes over a destination that is among its sources: each row
+    # is cut by the thread whose pass then walks it (dynamic chunks, which balance a wall
+    # list's uneven rows better, moved the rows between cores and cost more than they saved)
+    for i in prange(nd, nogil=True, schedule="static"):
+        kh = radius_scale * dest_h[i]
         cnt = _refine_row(g, open_box, i, pn, offsets[i], offsets[i + 1], xd[0], xd[1], xd[2],
                           kh * kh, pts, po + offsets[i])
         ends[i] = <int>(offsets[i] + cnt)
