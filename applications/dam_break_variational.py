@@ -172,9 +172,7 @@ class DamBreakVariational(Application):
     def _write_progress(self, **state):
         """history.json and info.json (base class) and steps.json: one row per step."""
         super()._write_progress(**state)
-        io.write_json(os.path.join(self.outdir, "steps.json"),
-                      {"columns": list(STEP_COLUMNS), "rows": self.steps,
-                       "evaluations": getattr(self.solver.integrator, "evaluations", None)})
+        write_steps(self)
 
     def _signature(self, arrays):
         """The scene's identity for restarts: --reference-run only changes the analysis."""
@@ -300,6 +298,14 @@ class DamBreakVariational(Application):
         fig.tight_layout()
         fig.savefig(os.path.join(outdir, "iterations.png"), dpi=100)
         plt.close(fig)
+
+
+def write_steps(app):
+    """steps.json of a variational application: its per-step rows (STEP_COLUMNS) and the
+    integrator's evaluation counts."""
+    io.write_json(os.path.join(app.outdir, "steps.json"),
+                  {"columns": list(STEP_COLUMNS), "rows": app.steps,
+                   "evaluations": getattr(app.solver.integrator, "evaluations", None)})
 
 
 def earlier_steps(path, t):

@@ -31,7 +31,7 @@ from sphgen.particles import ParticleArray
 
 from ..equations.variational import kernel_parameters
 from ..schemes.variational import PREDICTORS, VariationalScheme
-from .dam_break_variational import STEP_COLUMNS, earlier_steps, iteration_statistics, position_error
+from .dam_break_variational import earlier_steps, iteration_statistics, position_error, write_steps
 
 try:
     from sphgen.errors import InputError
@@ -127,9 +127,7 @@ class LatticeVariational(Application):
 
     def _write_progress(self, **state):
         super()._write_progress(**state)
-        io.write_json(os.path.join(self.outdir, "steps.json"),
-                      {"columns": list(STEP_COLUMNS), "rows": self.steps,
-                       "evaluations": getattr(self.solver.integrator, "evaluations", None)})
+        write_steps(self)
 
     def _restart(self, path, data, dt):
         """Continue the energy series exactly: the per-step rows, the state at t_k the next
