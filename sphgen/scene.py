@@ -133,9 +133,10 @@ class Scene:
     def describe(self):
         return self.plan.describe()
 
-    def max_speed2(self):
-        """[(array, largest |u|^2, its particle index)] over arrays with velocities."""
-        return self.engine.max_speed2(self.arrays)
+    def extremes(self):
+        """[(array, largest |u|^2, its particle, smallest rho, its particle, largest rho, its
+        particle)] over the arrays with velocities or a density (-1 where there is none)."""
+        return self.engine.extremes(self.arrays)
 
     def check_finite(self):
         """None if all allocated float data is finite, else (array, prop, particle index).

@@ -265,7 +265,8 @@ class Solver:
         bad = self.scene.check_finite()
         if bad is not None:
             self._blow_up(dt, "non-finite {}.{} at particle {}".format(*bad))
-        for what in (self._check_speed(), self._check_density(), self._check_neighbours()):
+        extremes = self.scene.extremes()
+        for what in (self._check_speed(extremes), self._check_density(extremes), self._check_neighbours()):
             if what:
                 self._blow_up(dt, what)
         self._snapshot()
@@ -290,27 +291,27 @@ class Solver:
             self.write_output()
 
     # ---------------------------------------------------------------- guard
-    def _check_speed(self):
+    def _check_speed(self, extremes):
         """A particle faster than the scheme's limit (e.g. Mach 1 for weak compressibility)."""
         if self.speed_limit is None:
             return None
-        for name, speed2, i in self.scene.max_speed2():
-            if speed2 > self.speed_limit ** 2:
+        for name, speed2, i, *_ in extremes:
+            if i >= 0 and speed2 > self.speed_limit ** 2:
                 comps = ", ".join(("u", "v", "w")[:self.scene.dim])
                 return (f"speed |({comps})| = {np.sqrt(speed2):.3g} of {name} particle {i} is above "
                         f"the scheme's limit {self.speed_limit:.3g}")
         return None
 
-    def _check_density(self):
-        for name, (lo, hi) in self.density_bounds.items():
-            rho = self.scene.by_name[name].data.get("rho")
-            if rho is None or rho.size == 0:
+    def _check_density(self, extremes):
+        """A density outside the scheme's bounds (from the same sweep as the speeds)."""
+        for name, _, _, rmin, i, rmax, j in extremes:
+            if name not in self.density_bounds:
                 continue
-            i, j = int(np.argmin(rho)), int(np.argmax(rho))
-            if rho[i] < lo:
-                return f"density {name}.rho = {rho[i]:.4g} at particle {i} is below the bound {lo:.4g}"
-            if rho[j] > hi:
-                return f"density {name}.rho = {rho[j]:.4g} at particle {j} is above the bound {hi:.4g}"
+            lo, hi = self.density_bounds[name]
+            if i >= 0 and rmin < lo:
+                return f"density {name}.rho = {rmin:.4g} at particle {i} is below the bound {lo:.4g}"
+            if j >= 0 and rmax > hi:
+                return f"density {name}.rho = {rmax:.4g} at particle {j} is above the bound {hi:.4g}"
         return None
 
     def _check_neighbours(self):

@@ -146,7 +146,7 @@ def test_show_plan_reports_every_pass_in_order():
 
 def test_a_pass_over_other_arrays_only_is_scheduled_in_dynamic_chunks():
     """A wall that only sees the fluid gets dynamic chunks (most wall particles may have no
-    neighbour); a pass whose destination is among its sources keeps static halves."""
+    neighbour); a pass whose destination is among its sources runs the array's thread parts."""
     from sphgen.codegen.render import render
     fluid, wall = lattice_cloud("fluid", nx=6), lattice_cloud("wall", nx=6, seed=1)
     sc = Scene([fluid, wall], [Group([SummationDensity("wall", ["fluid"])]),
@@ -155,4 +155,5 @@ def test_a_pass_over_other_arrays_only_is_scheduled_in_dynamic_chunks():
                outputs={"fluid": ["rho"], "wall": ["rho"]})
     src = render(sc.plan).source
     loops = dict(re.findall(r"prange\((\w+)_n, num_threads=_nthreads, (schedule=[^)]*)\):\n\s+_pass", src))
-    assert loops == {"wall": "schedule='dynamic', chunksize=64", "fluid": "schedule='static'"}
+    assert loops == {"wall": "schedule='dynamic', chunksize=64"}
+    assert re.search(r"for d_idx in range\(_part_fluid\[k\], _part_fluid\[k \+ 1\]\):\n\s+_pass_\w+_fluid", src)

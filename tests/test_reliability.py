@@ -265,5 +265,8 @@ def test_snapshot_restores_every_array_bit_for_bit(tmp_path, backend, nx):
         fluid.u[:] = rng.uniform(-1, 1, fluid.n)
         fluid.v[:] = rng.uniform(-1, 1, fluid.n)
         fluid.u[where], fluid.v[where] = 3.0, -2.0
-        ((name, speed2, i),) = solver.scene.max_speed2()
+        fluid.rho[:] = rng.uniform(0.9, 1.1, fluid.n)
+        fluid.rho[where], fluid.rho[-1 - where] = 0.5, 2.0
+        ((name, speed2, i, rmin, imin, rmax, imax),) = [e for e in solver.scene.extremes() if e[0] == "fluid"]
         assert (name, i) == ("fluid", where) and speed2 == 13.0
+        assert (imin, rmin, imax, rmax) == (where, 0.5, fluid.n - 1 - where, 2.0)

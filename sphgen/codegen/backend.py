@@ -49,15 +49,26 @@ class Backend:
             start = end
         return start
 
-    def max_speed2(self, arrays):
-        """[(array, largest |u|^2, its particle index)] over arrays with velocities."""
+    def extremes(self, arrays):
+        """[(array, largest |u|^2, its particle, smallest rho, its particle, largest rho,
+        its particle)] over the arrays with velocities or a density (-1: none)."""
         out = []
         for pa in arrays:
             comps = [pa.data[u] for u in ("u", "v", "w")[:self.plan.dim] if u in pa.data]
+            rho = pa.data.get("rho")
+            rho = rho if rho is not None and rho.dtype == np.float64 else None
+            if not (comps or rho is not None):
+                continue
+            row = [pa.name, 0.0, -1, np.inf, -1, -np.inf, -1]
             if comps and pa.n:
                 s2 = sum(c * c for c in comps)
                 i = int(np.argmax(s2))
-                out.append((pa.name, float(s2[i]), i))
+                if s2[i] > 0.0:
+                    row[1:3] = float(s2[i]), i
+            if rho is not None and pa.n:
+                i, j = int(np.argmin(rho)), int(np.argmax(rho))
+                row[3:] = float(rho[i]), i, float(rho[j]), j
+            out.append(tuple(row))
         return out
 
     def nonfinite_suspects(self, arrays):

@@ -71,12 +71,17 @@ class CompiledBackend(Backend):
         self._claim()
         self._stages[(st.array, name)](t, dt)
 
+    def parts(self, name):
+        """Thread k's particles of array ``name`` in every loop: ``parts[k] .. parts[k+1]-1``."""
+        self._claim()
+        return self.module.parts(name)
+
     def copy_arrays(self, arrays, out, save):
         return self.module.copy_arrays(arrays, out, save)
 
-    def max_speed2(self, arrays):
+    def extremes(self, arrays):
         self._claim()
-        return self.module.max_speed2()
+        return self.module.extremes()
 
     def nonfinite_suspects(self, arrays):
         self._claim()

@@ -55,7 +55,7 @@ class PassView:
     sources: list
     store_registers: list
     post_loop: list
-    schedule: str = "schedule='static'"   # the prange's schedule (see pass_view)
+    schedule: str = "parts"   # "parts", or the prange's schedule (see pass_schedule)
 
 
 @dataclass(frozen=True)
@@ -149,12 +149,13 @@ def pass_view(plan, p):
 
 
 def pass_schedule(p):
-    """Static halves for a pass whose destination is among its sources (every particle has
-    neighbours, about as many); dynamic chunks when it visits only other arrays (a wall
+    """The array's thread parts (``"parts"``: one per thread, cut by the neighbour candidates,
+    the same in every loop over the array) for a pass whose destination is among its
+    sources (every particle has neighbours); dynamic chunks when it visits only other arrays (a wall
     next to the fluid: most of its particles may have no neighbour, and static halves
     leave one thread the work)."""
     if not p.sources or any(loop.source == p.dest for loop in p.sources):
-        return "schedule='static'"
+        return "parts"
     return "schedule='dynamic', chunksize=64"
 
 
@@ -168,14 +169,22 @@ def _method_code(fp):
 def _array_tables(plan):
     """What the module's data, guard and speed sections list, array by array."""
     alloc = [(name, {p: plan.dtype(name, p) for p in sorted(props)}) for name, props in plan.allocation.items()]
-    moving = [(name, [u for u in ("u", "v", "w")[:plan.dim] if u in props]) for name, props in alloc
-              if "u" in props]
+    speed = {name: [u for u in ("u", "v", "w")[:plan.dim] if u in props] for name, props in alloc
+             if "u" in props}
     return dict(
         allocation=[(name, [(p, t, _NUMPY[t]) for p, t in props.items()]) for name, props in alloc],
         constants=[(name, sorted(pa.constants)) for name, pa in plan.arrays.items() if pa.constants],
         guarded=[(name, [(p, plan.arrays[name].props[p].stride) for p, t in props.items() if t == "double"])
                  for name, props in alloc],
-        moving=[(name, " + ".join(f"{name}_{u}[i] * {name}_{u}[i]" for u in comps)) for name, comps in moving])
+        scanned=[(name, " + ".join(f"{name}_{u}[i] * {name}_{u}[i]" for u in speed.get(name, ())),
+                  props.get("rho") == "double") for name, props in alloc
+                 if name in speed or props.get("rho") == "double"])
+
+
+def _parts_table(plan, lists):
+    """(array, the keys of the neighbour lists of which it is the destination): each array's
+    particles are cut into one part per thread, balanced by the candidates of these lists."""
+    return [(name, [k for k, (dest, _, _) in lists.items() if dest == name]) for name in plan.allocation]
 
 
 def render(plan):
@@ -190,7 +199,7 @@ def render(plan):
         kernel_code=[to_cython(sp) for sp in plan.kernel_functions],
         helper_code=[to_cython(sp) for sp in plan.helpers],
         method_code=[_method_code(fp) for fp in plan.functions],
-        passes=passes, stages=stages, **_array_tables(plan))
+        passes=passes, stages=stages, parts=_parts_table(plan, lists), **_array_tables(plan))
     return Rendered(
         source=source, parameters=dict(plan.parameters),
         pass_entries={p.name: f"pass_{p.name}" for p in passes},

@@ -5,7 +5,7 @@ from libc.math cimport *
 cimport numpy as cnp
 import numpy as np
 from cython.parallel cimport prange
-from libc.stdlib cimport free, malloc
+from libc.stdlib cimport free, malloc, realloc
 from libc.string cimport memcpy
 
 cdef extern from *:
@@ -20,6 +20,8 @@ cdef extern from *:
     void sphgen_set_omp_threads(int n) noexcept nogil
 cnp.import_array()
 
+cdef enum:
+    MAX_THREADS = 256     # the most threads a module runs
 cdef int _nthreads = 1
 _keep = {}
 
@@ -42,6 +44,95 @@ cdef int* ${key}_off = NULL
 cdef int* ${key}_end = NULL
 cdef int* ${key}_idx = NULL
 % endfor
+
+# ---------------------------------------------------------------- thread parts
+# Thread k runs particles _part_A[k] .. _part_A[k+1]-1 of array A in every pass, stage and
+# guard sweep over A, so the data a thread writes stay in its core's cache from loop to
+# loop.  The cuts balance the neighbour candidates of A's lists plus PART_WEIGHT per
+# particle (equal counts would leave one thread up to 8 % more pairs in a free-surface
+# flow); without lists, equal counts.
+cdef enum:
+    PART_WEIGHT = 4       # a particle's own work, in neighbour candidates
+% for arr, keys in parts:
+cdef long* _part_${arr} = NULL
+cdef long _listed_n_${arr} = -1     # ${arr}_n when its lists were bound (-1: none)
+% endfor
+
+
+cdef int _cut(long** part, long n, int nt, int** starts, int** ends, int nlists) except -1:
+    """Cut n particles into nt parts: work(i) = sum of the lists' starts[i] + PART_WEIGHT i
+    (nondecreasing; the candidates before particle i), the k-th cut where work reaches k/nt
+    of the whole (the ends of the last rows).  Equal counts without lists."""
+    cdef long* p = <long*>realloc(part[0], (nt + 1) * sizeof(long))
+    cdef long k, lo, hi, mid, total = PART_WEIGHT * n, goal
+    cdef int l
+    if p == NULL:
+        raise MemoryError("thread parts")
+    part[0] = p
+    p[0] = 0
+    p[nt] = n
+    if n == 0 or nlists == 0:
+        for k in range(1, nt):
+            p[k] = n * k // nt
+        return 0
+    for l in range(nlists):
+        total += ends[l][n - 1]
+    for k in range(1, nt):
+        goal = total * k // nt
+        lo, hi = p[k - 1], n          # the smallest i in [lo, hi] with work(i) >= goal
+        while lo < hi:
+            mid = (lo + hi) // 2
+            if _work(starts, nlists, mid, n, total) >= goal:
+                hi = mid
+            else:
+                lo = mid + 1
+        if lo > p[k - 1] and (goal - _work(starts, nlists, lo - 1, n, total)
+                              < _work(starts, nlists, lo, n, total) - goal):
+            lo -= 1                   # the nearer of the two cuts around the goal
+        p[k] = lo
+    return 0
+
+
+cdef inline long _work(int** starts, int nlists, long i, long n, long total) noexcept nogil:
+    """The candidates of particles 0..i-1 plus PART_WEIGHT each (``total`` at i = n)."""
+    cdef long w = PART_WEIGHT * i
+    cdef int l
+    if i >= n:
+        return total
+    for l in range(nlists):
+        w += starts[l][i]
+    return w
+
+
+def _rebalance():
+    """Cut every array for the current thread count, by its lists where they are bound for
+    its current particle count."""
+    cdef int* starts[${max([len(k) for _, k in parts] + [1])}]
+    cdef int* ends[${max([len(k) for _, k in parts] + [1])}]
+    cdef int nl
+% for arr, keys in parts:
+    nl = 0
+% if keys:
+    if _listed_n_${arr} == ${arr}_n:
+% for key in keys:
+        if ${key}_off != NULL:
+            starts[nl] = ${key}_off
+            ends[nl] = ${key}_end
+            nl += 1
+% endfor
+% endif
+    _cut(&_part_${arr}, ${arr}_n, _nthreads, starts, ends, nl)
+% endfor
+
+
+def parts(str name):
+    """The cuts of array ``name`` (thread k runs particles parts[k] .. parts[k+1]-1)."""
+% for arr, keys in parts:
+    if name == '${arr}':
+        return [_part_${arr}[k] for k in range(_nthreads + 1)]
+% endfor
+    raise KeyError(name)
+
 
 # ---------------------------------------------------------------- parameters
 % for g in param_globals:
@@ -106,22 +197,32 @@ cdef void _pass_${p.name}(long d_idx, double t, double dt) noexcept nogil:
 
 def pass_${p.name}(double t, double dt):
     cdef long d_idx
+% if p.schedule == "parts":
+    cdef int k
+    with nogil:
+        for k in prange(_nthreads, num_threads=_nthreads, schedule='static'):
+            for d_idx in range(_part_${p.dest}[k], _part_${p.dest}[k + 1]):
+                _pass_${p.name}(d_idx, t, dt)
+% else:
     with nogil:
         for d_idx in prange(${p.dest}_n, num_threads=_nthreads, ${p.schedule}):
             _pass_${p.name}(d_idx, t, dt)
+% endif
 
 % endfor
 # ---------------------------------------------------------------- integrator stages
 % for s in stages:
 def stage_${s.name}(double t, double dt):
     cdef long d_idx
-    # static halves, as the passes over this array: each thread updates the particles whose
+    cdef int k
+    # the parts of the passes over this array: each thread updates the particles whose
     # rates it computed, so no particle's data moves between cores (a serial stage costs
     # 13x more on the dam break on two threads than serially: every line it reads is in the
     # other core's cache)
     with nogil:
-        for d_idx in prange(${s.array}_n, num_threads=_nthreads, schedule='static'):
-            ${s.call}
+        for k in prange(_nthreads, num_threads=_nthreads, schedule='static'):
+            for d_idx in range(_part_${s.array}[k], _part_${s.array}[k + 1]):
+                ${s.call}
 
 % endfor
 # ---------------------------------------------------------------- blow-up guard
@@ -132,11 +233,13 @@ def count_nonfinite():
     each property counted on its own."""
     cdef long i
     cdef long bad = 0
+    cdef int k
 % for arr, props in guarded:
 % for stride in sorted(set(st for _, st in props)):
     with nogil:
-        for i in prange(${arr}_n * ${stride}, num_threads=_nthreads, schedule='static'):
-            bad += ${" + ".join(f"(not isfinite({arr}_{p}[i]))" for p, st in props if st == stride)}
+        for k in prange(_nthreads, num_threads=_nthreads, schedule='static'):
+            for i in range(_part_${arr}[k] * ${stride}, _part_${arr}[k + 1] * ${stride}):
+                bad += ${" + ".join(f"(not isfinite({arr}_{p}[i]))" for p, st in props if st == stride)}
 % endfor
 % endfor
     if bad == 0:
@@ -162,33 +265,60 @@ def _count_nonfinite_each():
     return out
 
 
-def max_speed2():
-    """[(array, largest |u|^2, its particle)] for the arrays with velocities; thread k scans
-    the k-th of ``_nthreads`` equal parts (the particles it updates), then the parts' maxima
-    are compared."""
+def extremes():
+    """[(array, largest |u|^2, its particle, smallest rho, its particle, largest rho, its
+    particle)] for the arrays with velocities or a density (-1 for a particle where the
+    array has none): the guard's speed and density look in one sweep.  Thread k scans the
+    k-th part of the array (the particles it updates, so nothing moves between cores),
+    then the parts are compared; ties go to the first particle, as numpy's argmax."""
     cdef long i, k, lo, hi
-    cdef long[64] at
-    cdef double[64] best
-    cdef double s2
-    cdef int nt = min(_nthreads, 64)
+    cdef long[MAX_THREADS] at
+    cdef long[MAX_THREADS] at_lo
+    cdef long[MAX_THREADS] at_hi
+    cdef double[MAX_THREADS] best
+    cdef double[MAX_THREADS] rlo
+    cdef double[MAX_THREADS] rhi
+    cdef double s2, r
+    cdef int nt = _nthreads
     out = []
-% for arr, speed2 in moving:
+% for arr, speed2, rho in scanned:
     with nogil:
         for k in prange(nt, num_threads=nt, schedule='static'):
-            lo = ${arr}_n * k // nt
-            hi = ${arr}_n * (k + 1) // nt
+            lo = _part_${arr}[k]
+            hi = _part_${arr}[k + 1]
             best[k] = 0.0
             at[k] = -1
+            rlo[k] = INFINITY
+            rhi[k] = -INFINITY
+            at_lo[k] = -1
+            at_hi[k] = -1
             for i in range(lo, hi):
+% if speed2:
                 s2 = ${speed2}
                 if s2 > best[k]:
                     best[k] = s2
                     at[k] = i
+% endif
+% if rho:
+                r = ${arr}_rho[i]
+                if r < rlo[k]:
+                    rlo[k] = r
+                    at_lo[k] = i
+                if r > rhi[k]:
+                    rhi[k] = r
+                    at_hi[k] = i
+% endif
     for k in range(1, nt):
         if best[k] > best[0]:
             best[0] = best[k]
             at[0] = at[k]
-    out.append(('${arr}', best[0], at[0]))
+        if rlo[k] < rlo[0]:
+            rlo[0] = rlo[k]
+            at_lo[0] = at_lo[k]
+        if rhi[k] > rhi[0]:
+            rhi[0] = rhi[k]
+            at_hi[0] = at_hi[k]
+    out.append(('${arr}', best[0], at[0], rlo[0], at_lo[0], rhi[0], at_hi[0]))
 % endfor
     return out
 
@@ -196,8 +326,9 @@ def max_speed2():
 def copy_arrays(list arrays, cnp.ndarray out, bint save):
     """The guard's snapshot: the bytes of every array, one after the other, into ``out``
     (``save``) or back from it.  Thread k copies the k-th of ``_nthreads`` equal parts of
-    every array: the part whose particles it updates in the static passes and stages, so
-    the copy reads (and a restore writes) what is already in its own core's cache."""
+    every array: about the particles it updates in the passes and stages (their parts are
+    cut by neighbour counts, a few per cent off equal), so the copy reads (and a restore
+    writes) mostly what is already in its own core's cache."""
     cdef Py_ssize_t narr = len(arrays), total = 0, nb, j, k, lo, hi
     cdef int nt = _nthreads
     cdef char* base = <char*>cnp.PyArray_DATA(out)
@@ -274,11 +405,18 @@ def bind_arrays(dict arrays):
     ${arr}_${c} = <double*>_ptr(arrays['${arr}'][1]['${c}'], '${arr}.${c}')
 % endfor
 % endfor
+    _rebalance()
 
 
 def bind_neighbours(dict lists):
     """lists: {key: (starts, ends, indices)}, int32: the neighbours of d_idx are
-    indices[starts[d_idx]:ends[d_idx]]."""
+    indices[starts[d_idx]:ends[d_idx]] (every list of a destination given together, for its
+    current particles); the arrays are cut anew by them."""
+% for arr, keys in parts:
+% if keys:
+    global _listed_n_${arr}
+% endif
+% endfor
 % for key in nbr_keys:
     global ${key}_off, ${key}_end, ${key}_idx
 % endfor
@@ -289,7 +427,12 @@ def bind_neighbours(dict lists):
         ${key}_end = <int*>_ptr(e, '${key}.end')
         ${key}_idx = <int*>_ptr(i, '${key}.idx')
 % endfor
-    pass
+% for arr, keys in parts:
+% if keys:
+    _listed_n_${arr} = ${arr}_n
+% endif
+% endfor
+    _rebalance()
 
 
 def set_parameters(dict p):
@@ -303,7 +446,9 @@ def set_parameters(dict p):
 
 
 def set_threads(int n):
-    """Threads of this module's loops; also the OpenMP default, which the neighbour search uses."""
+    """Threads of this module's loops (at most MAX_THREADS); also the OpenMP default, which
+    the neighbour search uses.  The arrays are cut anew for them."""
     global _nthreads
-    _nthreads = max(1, n)
+    _nthreads = min(max(1, n), MAX_THREADS)
     sphgen_set_omp_threads(_nthreads)
+    _rebalance()

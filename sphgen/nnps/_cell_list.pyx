@@ -47,10 +47,28 @@ import numpy as np
 cdef double _REACH_MARGIN = 1.000002
 # rows up to this length are sorted by insertion, longer ones by merging runs
 cdef Py_ssize_t _SHORT_ROW = 48
-# loops of a few operations per item run serially below this many items: a parallel
-# region's start and join (a few microseconds) cost more than the loop (dam break,
-# 3 384 particles: gathering the source records took 3.4 us serially, 4.8 us on 2 threads)
-cdef Py_ssize_t _SERIAL_BELOW = 16384
+# A loop over the particles of one array runs on every OpenMP thread in static parts,
+# however short it is: thread k then touches the particles that the static passes and
+# stages of the generated module give it, and the data stay in its core's cache.  A
+# serial scan was cheaper by itself (a parallel region's start and join cost a few
+# microseconds) but pulled the other core's half over, and that core's next write paid
+# for it (dam break: the stage after a serial read of x, y, h took 26 us instead of 7).
+cdef extern from *:
+    """
+    #ifdef _OPENMP
+    #include <omp.h>
+    static int sphgen_max_threads(void) { return omp_get_max_threads(); }
+    #else
+    static int sphgen_max_threads(void) { return 1; }
+    #endif
+    """
+    int sphgen_max_threads() noexcept nogil
+
+
+cdef Py_ssize_t _static_parts(Py_ssize_t n) noexcept nogil:
+    """How many parts a per-particle reduction of ``n`` items is cut into: one per thread."""
+    cdef Py_ssize_t nt = sphgen_max_threads()
+    return max(1, min(nt, n, 64))
 
 
 ctypedef struct Grid:
@@ -694,9 +712,11 @@ cdef void _motion_chunk(int dim, const double** x, const double** r, const doubl
 def largest_motion(list coords, list refs, double[::1] h, double[::1] h_ref, lengths):
     """``(largest |x - x_ref|^2, largest |h - h_ref|)`` over the particles of one array;
     ``lengths[a] > 0`` makes axis ``a`` periodic (minimum image).  NaN for both as soon
-    as a value is not finite (the caller then rebuilds, which names it).  From
-    ``_SERIAL_BELOW`` particles on, threaded over chunks, each chunk's maxima reduced after."""
-    cdef Py_ssize_t n = h.shape[0], c, nchunks, size
+    as a value is not finite (the caller then rebuilds, which names it).  Thread k scans
+    the k-th of the OpenMP threads' equal parts (the particles whose positions it updates
+    in the static stages: a serial scan would pull the other core's half to this one and
+    make its next write pay for it); the parts' maxima are compared after."""
+    cdef Py_ssize_t n = h.shape[0], c, nchunks
     cdef int a, dim = len(coords)
     cdef const double* x[3]
     cdef const double* r[3]
@@ -710,13 +730,13 @@ def largest_motion(list coords, list refs, double[::1] h, double[::1] h_ref, len
         L[a] = float(lengths[a])
     if n == 0:
         return 0.0, 0.0
-    nchunks = 1 if n < _SERIAL_BELOW else min(64, (n + 1023) // 1024)
-    size = (n + nchunks - 1) // nchunks
+    nchunks = _static_parts(n)
     cdef double[:, ::1] part = np.empty((nchunks, 2))
     if nchunks == 1:
         _motion_chunk(dim, x, r, L, &h[0], &h_ref[0], 0, n, &part[0, 0])
-    for c in prange(nchunks if nchunks > 1 else 0, nogil=True, schedule="static"):
-        _motion_chunk(dim, x, r, L, &h[0], &h_ref[0], c * size, min(n, (c + 1) * size), &part[c, 0])
+    for c in prange(nchunks if nchunks > 1 else 0, nogil=True, schedule="static", num_threads=nchunks):
+        _motion_chunk(dim, x, r, L, &h[0], &h_ref[0], n * c // nchunks, n * (c + 1) // nchunks,
+                      &part[c, 0])
     for c in range(nchunks):
         if not (isfinite(part[c, 0]) and isfinite(part[c, 1])):
             return float("nan"), float("nan")
@@ -893,13 +913,7 @@ def gather_points(list coords, double[::1] h, double radius_scale, double[:, ::1
         raise ValueError("gather_points: out must have (n, 4) entries")
     for a in range(dim):
         x[a] = _coord_ptr(coords[a], n)
-    if n < _SERIAL_BELOW:
-        for i in range(n):
-            for a in range(3):
-                out[i, a] = x[a][i] if a < dim else 0.0
-            kh = radius_scale * h[i]
-            out[i, 3] = kh * kh
-        return out
+    # static parts, as the stages that wrote x: each thread gathers its own particles
     for i in prange(n, nogil=True, schedule="static"):
         for a in range(3):
             out[i, a] = x[a][i] if a < dim else 0.0
@@ -984,14 +998,6 @@ def refine_rows(GridSpec grid, int[::1] offsets, int[::1] nbrs, list dest_coords
     for a in range(3):
         xd[a] = _coord_ptr(dest_coords[a], nd) if a < g.dim else NULL
     cdef bint open_box = g.dim >= 2 and not (g.periodic[0] or g.periodic[1] or g.periodic[2])
-    if nbrs.shape[0] < _SERIAL_BELOW:
-        for i in range(nd):
-            kh = radius_scale * dest_h[i]
-            cnt = _refine_row(g, open_box, i, pn, offsets[i], offsets[i + 1], xd[0], xd[1], xd[2],
-                              kh * kh, pts, po + offsets[i])
-            ends[i] = <int>(offsets[i] + cnt)
-            total += cnt
-        return total
     # static halves, as the passes over a destination that is among its sources: each row
     # is cut by the thread whose pass then walks it (dynamic chunks, which balance a wall
     # list's uneven rows better, moved the rows between cores and cost more than they saved)
