@@ -181,10 +181,11 @@ class IPSTShift(Equation):
     """
 
     positive = ("umax", "chi_ref", "tolerance")
-    switches = ("dim",)
+    switches = ("dim", "near_surface")
 
-    def __init__(self, dest, sources, umax=1.0, chi_ref=1.0, tolerance=0.02, dim=2):
-        super().__init__(dest, sources, umax=umax, chi_ref=chi_ref, tolerance=tolerance, dim=int(dim))
+    def __init__(self, dest, sources, umax=1.0, chi_ref=1.0, tolerance=0.02, dim=2, near_surface=False):
+        super().__init__(dest, sources, umax=umax, chi_ref=chi_ref, tolerance=tolerance, dim=int(dim),
+                         near_surface=bool(near_surface))
         self.inhomogeneity = np.inf
         self.shifted = True
 
@@ -207,6 +208,32 @@ class IPSTShift(Equation):
                 d_ipst_dy[d_idx] += f * XIJ[1]
             if self.dim > 2:
                 d_ipst_dz[d_idx] += f * XIJ[2]
+
+    def post_loop(self, d_idx, d_ipst_dx, d_ipst_dy, d_ipst_dz, d_free_surface, d_h_b, d_h, d_normal):
+        """``near_surface``: eq. 45, the filter of eq. 44 on every iteration's shift: none on
+        a free-surface particle, no normal component where h_b < h (the flags, h_b and the
+        normals of the step's start: section 3.5 computes them once per step)."""
+        if self.near_surface:
+            if d_free_surface[d_idx] > 0.5:
+                d_ipst_dx[d_idx] = 0.0
+                if self.dim > 1:
+                    d_ipst_dy[d_idx] = 0.0
+                if self.dim > 2:
+                    d_ipst_dz[d_idx] = 0.0
+            elif d_h_b[d_idx] < d_h[d_idx]:
+                nx = d_normal[3 * d_idx]
+                ny = d_normal[3 * d_idx + 1]
+                nz = d_normal[3 * d_idx + 2]
+                dn = d_ipst_dx[d_idx] * nx
+                if self.dim > 1:
+                    dn += d_ipst_dy[d_idx] * ny
+                if self.dim > 2:
+                    dn += d_ipst_dz[d_idx] * nz
+                d_ipst_dx[d_idx] -= dn * nx
+                if self.dim > 1:
+                    d_ipst_dy[d_idx] -= dn * ny
+                if self.dim > 2:
+                    d_ipst_dz[d_idx] -= dn * nz
 
     def reduce(self, dst, t, dt):
         sweep = int(dst.ipst_iter[0])
@@ -339,14 +366,16 @@ class Shifting:
     def _ipst_due(self, t, dt):
         return int(round(t / dt)) % self.ipst_interval == 0
 
-    def groups(self, dests, sources):
-        """Groups to run after the momentum group (IPST: start, iterate, acceleration)."""
+    def groups(self, dests, sources, near_surface=False):
+        """Groups to run after the momentum group (IPST: start, iterate, acceleration);
+        ``near_surface``: every iteration's shift filtered as eq. 45 (free surfaces)."""
         if self.kind != "ipst":
             return []
         cond = None if self.ipst_interval == 1 else self._ipst_due
         return [Group([IPSTStart(d, dim=self.dim) for d in dests], condition=cond),
                 Group([IPSTShift(d, sources, umax=self.umax, chi_ref=self.chi_ref,
-                                 tolerance=self.ipst_tolerance, dim=self.dim) for d in dests],
+                                 tolerance=self.ipst_tolerance, dim=self.dim, near_surface=near_surface)
+                       for d in dests],
                       iterate=True, max_iterations=self.ipst_max_iterations, condition=cond,
                       update_nnps=True),
                 Group([IPSTAcceleration(d, dim=self.dim) for d in dests], condition=cond,

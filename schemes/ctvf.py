@@ -175,8 +175,6 @@ class TransportVelocityScheme(Scheme):
         self.shift = Shifting(shifting, self.dim, h, dx, c0, umax, self.kernel, rho0=rho0, mach=mach,
                               pb=pb, p_ref=p_ref, ipst_tolerance=ipst_tolerance,
                               ipst_max_iterations=ipst_max_iterations, ipst_interval=ipst_interval)
-        if free_surface and self.shift.kind == "ipst":
-            raise ValueError("free surfaces with IPST (eq. 45) are not implemented; use shifting='spst'")
         if surface_pressure and not free_surface:
             raise ValueError("surface_pressure needs free_surface=True")
         self.free_surface, self.surface_pressure = bool(free_surface), bool(surface_pressure)
@@ -236,8 +234,9 @@ class TransportVelocityScheme(Scheme):
         own sources (one set of groups when every medium sees the same neighbours)."""
         sources = [self._sources(d) for d in self.fluids]
         if all(s == sources[0] for s in sources):
-            return self.shift.groups(self.fluids, sources[0])
-        return [g for d, s in zip(self.fluids, sources) for g in self.shift.groups([d], s)]
+            return self.shift.groups(self.fluids, sources[0], near_surface=self.free_surface)
+        return [g for d, s in zip(self.fluids, sources)
+                for g in self.shift.groups([d], s, near_surface=self.free_surface)]
 
     def _wall_groups(self):
         """Wall pressure (eq. 52) and density (linear equation of state), the no-slip ghost
@@ -323,8 +322,8 @@ class CTVFScheme(TransportVelocityScheme):
     Free surfaces (``free_surface=True``): every evaluation at new positions identifies
     the free-surface particles and their normals (section 3.4, cone test within
     ``cone_radius`` h) and h_b (section 3.5), and the SPST acceleration loses its normal
-    part near the surface and all of it on the surface (eq. 44; IPST's eq. 45 is not
-    implemented).  ``surface_pressure``: also hold p = 0 on free-surface particles (not
+    part near the surface and all of it on the surface (eq. 44; with IPST, every
+    iteration's shift, eq. 45).  ``surface_pressure``: also hold p = 0 on free-surface particles (not
     in the paper; see docs/ctvf.md).
     """
 
@@ -565,6 +564,6 @@ class CTVFSolidScheme(ElasticSolids, CTVFScheme):
         fluid_corrections = tuple(c for c in corrections if c in ("edac", "continuity"))
         super().__init__(solids, dim, rho0, c0, 0.0, h, dx, umax=umax, shifting=shifting,
                          corrections=fluid_corrections, density="continuity", alpha=alpha,
-                         free_surface=free_surface and shifting != "ipst", edac_damping=edac_damping, **kw)
+                         free_surface=free_surface, edac_damping=edac_damping, **kw)
         self._init_solid(G, clamped or {}, "jaumann" in corrections, yield_stress, contact, driven)
 

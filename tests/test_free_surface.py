@@ -130,3 +130,28 @@ def test_h_b_and_the_shifting_filter_near_the_surface():
     assert np.all(a[fs] == 0.0)
     np.testing.assert_allclose(np.sum(a[near] * n[near], axis=1), 0.0, atol=1e-12)
     assert np.all(a[~fs & ~near] == 1.0)
+
+
+@pytest.mark.parametrize("backend", ["python", "cython"])
+def test_ipst_shift_is_filtered_near_the_surface(backend):
+    """Eq. 45: every IPST iteration's shift gets the filter of eq. 44 (none on the surface,
+    no normal part where h_b < h); deeper particles shift as without the filter."""
+    from sphgen.equation import Group
+    from sphgen.equations import shifting
+    shifts = {}
+    for near in (False, True):
+        f, w = patch_on_wall()
+        shifting.Shifting("ipst", 2, DX, DX, 10.0, 1.0, QuinticSpline(2)).setup_properties(f)
+        groups = free_surface_groups(["fluid"], ["wall"], h_b_factor=3.0) + [
+            Group([shifting.IPSTShift("fluid", ["fluid", "wall"], umax=1.0, near_surface=near)])]
+        Scene([f, w], groups, kernel=QuinticSpline(2), dim=2, backend=backend,
+              outputs={"fluid": ["free_surface", "normal", "h_b", "ipst_dx", "ipst_dy"]}).compute(0, 0.0, 1e-3)
+        shifts[near] = np.column_stack([f.ipst_dx, f.ipst_dy])
+    fs, near = f.free_surface > 0, ~(f.free_surface > 0) & (f.h_b < DX)
+    deep = ~fs & ~near
+    n = f.normal.reshape(-1, 3)[:, :2]
+    assert fs.sum() > 10 and near.sum() > 10 and deep.sum() > 0
+    assert np.all(shifts[True][fs] == 0.0) and np.abs(shifts[False][fs]).max() > 1e-8
+    np.testing.assert_allclose(np.sum(shifts[True][near] * n[near], axis=1), 0.0, atol=1e-15)
+    assert np.abs(np.sum(shifts[False][near] * n[near], axis=1)).max() > 1e-8
+    np.testing.assert_array_equal(shifts[True][deep], shifts[False][deep])
