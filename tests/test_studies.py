@@ -41,6 +41,24 @@ def test_precision_and_stress_write_tables_and_plots(tmp_path, capsys):
     assert os.path.getsize(s / "stress.png") > 1000
 
 
+def test_precision_repeat_takes_the_fastest_round_and_checks_the_errors(tmp_path):
+    d = tmp_path / "prec"
+    assert main(["precision", "taylor_green", "--nx", "12", "--tf", "0.02", "--no-openmp", "--repeat", "3",
+                 "-d", str(d)]) == 0
+    (run,) = json.load(open(d / "precision.json"))["runs"]
+    times = run["info"]["wall_times"]
+    assert len(times) == 3 and run["info"]["wall_time"] == min(times) and run["info"]["completed"]
+    # rounds whose errors differ fail the row (a run is deterministic)
+    from sphgen.studies import fastest_round
+    rounds = [[{"exit": 0, "message": "", "info": {"wall_time": t, "completed": True},
+                "results": {"e": e}}] for t, e in ((2.0, 0.1), (1.0, 0.1), (1.5, 0.2))]
+    (row,) = fastest_round(rounds, "e")
+    assert row["info"]["wall_time"] == 1.0 and row["exit"] == 1 and not row["info"]["completed"]
+    assert "rounds differ" in row["message"]
+    with pytest.raises(SystemExit):
+        main(["precision", "taylor_green", "--repeat", "0", "-d", str(tmp_path / "x")])
+
+
 def test_stress_fails_when_a_run_blows_up_within_the_stable_factor(tmp_path):
     code = main(["stress", "taylor_green", "--runs", "1", "--nx", "12", "--tf", "0.3", "--no-openmp",
                  "--dt-factor", "40", "--stable-factor", "50", "-d", str(tmp_path)])
