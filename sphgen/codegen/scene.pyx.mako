@@ -452,3 +452,6 @@ def set_threads(int n):
     _nthreads = min(max(1, n), MAX_THREADS)
     sphgen_set_omp_threads(_nthreads)
     _rebalance()
+
+
+_rebalance()      # every array has its parts (of no particles) before anything is bound
