@@ -3,7 +3,7 @@ import ast
 
 from sphgen.codegen import passes
 from sphgen.codegen.plan import new_plan
-from sphgen.equation import Equation
+from sphgen.equation import Equation, Group
 from sphgen.kernels import QuinticSpline
 
 from conftest import lattice_cloud
@@ -80,6 +80,13 @@ def test_dead_stores_are_removed_and_the_method_specialised_again():
         "    d_p[d_idx] = c2 * (d_rho[d_idx] - 1.0)")
     assert ep.dead_stores == {"d_c2"} and ("fluid", "c2") not in ep.touched()
     assert "Pressure[fluid]: removed the stores to c2" in notes
+
+
+def test_one_note_for_an_equation_used_in_several_groups():
+    plan = _plan([Group([Pressure("fluid")]), Group([Pressure("fluid")])], ["p"])
+    notes = passes.prune(plan)
+    assert notes.count("Pressure[fluid]: removed the stores to c2 (in 2 places)") == 1
+    assert not any(n == "Pressure[fluid]: removed the stores to c2" for n in notes)
 
 
 class Scratch(Equation):

@@ -73,4 +73,13 @@ def prune(plan):
             removed.append(f"{ep.name}: removed the stores to {', '.join(sorted(s[2:] for s in stores))}")
     pruned = [f"prune {ep.name}: {ep.reason}" for ep in plan.eqplans if ep.has_work and not ep.kept]
     gone = [f"prune {ep.name}: {ep.reason}" for ep in plan.eqplans if ep.dead_stores and not ep.has_work]
-    return pruned + gone + removed
+    return _counted(pruned + gone + removed)
+
+
+def _counted(notes):
+    """The notes in order, each once; one that several uses of an equation (in several
+    groups or equation sets) gave alike says how many."""
+    counts = {}
+    for n in notes:
+        counts[n] = counts.get(n, 0) + 1
+    return [n if k == 1 else f"{n} (in {k} places)" for n, k in counts.items()]
