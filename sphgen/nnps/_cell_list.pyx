@@ -48,8 +48,9 @@ cdef double _REACH_MARGIN = 1.000002
 # rows up to this length are sorted by insertion, longer ones by merging runs
 cdef Py_ssize_t _SHORT_ROW = 48
 # A loop over the particles of one array runs on every OpenMP thread in static parts,
-# however short it is: thread k then touches the particles that the static passes and
-# stages of the generated module give it, and the data stay in its core's cache.  A
+# however short it is: thread k then touches about the particles that the passes and
+# stages of the generated module give it (their parts are cut by neighbour candidates, a
+# few per cent off equal counts), and the data stay in its core's cache.  A
 # serial scan was cheaper by itself (a parallel region's start and join cost a few
 # microseconds) but pulled the other core's half over, and that core's next write paid
 # for it (dam break: the stage after a serial read of x, y, h took 26 us instead of 7).
@@ -713,8 +714,8 @@ def largest_motion(list coords, list refs, double[::1] h, double[::1] h_ref, len
     """``(largest |x - x_ref|^2, largest |h - h_ref|)`` over the particles of one array;
     ``lengths[a] > 0`` makes axis ``a`` periodic (minimum image).  NaN for both as soon
     as a value is not finite (the caller then rebuilds, which names it).  Thread k scans
-    the k-th of the OpenMP threads' equal parts (the particles whose positions it updates
-    in the static stages: a serial scan would pull the other core's half to this one and
+    the k-th of the OpenMP threads' equal parts (about the particles whose positions it
+    updates in the stages: a serial scan would pull the other core's half to this one and
     make its next write pay for it); the parts' maxima are compared after."""
     cdef Py_ssize_t n = h.shape[0], c, nchunks
     cdef int a, dim = len(coords)
