@@ -265,7 +265,8 @@ class Solver:
         bad = self.scene.check_finite()
         if bad is not None:
             self._blow_up(dt, "non-finite {}.{} at particle {}".format(*bad))
-        extremes = self.scene.extremes()
+        # the speed and density sweep only where a limit or a bound asks for it
+        extremes = self.scene.extremes() if self.speed_limit is not None or self.density_bounds else []
         for what in (self._check_speed(extremes), self._check_density(extremes), self._check_neighbours()):
             if what:
                 self._blow_up(dt, what)
