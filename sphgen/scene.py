@@ -138,6 +138,16 @@ class Scene:
         particle)] over the arrays with velocities or a density (-1 where there is none)."""
         return self.engine.extremes(self.arrays)
 
+    def set_guard_limits(self, speed_limit, density_bounds):
+        """The largest speed (None: none) and the {array: (lo, hi)} density bounds that
+        :meth:`state_is_good` checks."""
+        self.engine.set_guard_limits(speed_limit, density_bounds)
+
+    def state_is_good(self):
+        """True when all float data is finite and within the guard's limits: one sweep,
+        which does not say where (:meth:`check_finite` and :meth:`extremes` do)."""
+        return self.engine.state_is_good(self.arrays)
+
     def check_finite(self):
         """None if all allocated float data is finite, else (array, prop, particle index).
 

@@ -230,6 +230,7 @@ class Solver:
             self._bar.update(self.t)
         if self.guard:
             self._pairs0 = self.scene.nnps.pair_totals()
+            self.scene.set_guard_limits(self.speed_limit, self.density_bounds or {})
             self._snapshot()
 
     def _finished(self):
@@ -259,18 +260,29 @@ class Solver:
         return dt
 
     def _check(self, dt):
-        """The guard's checks (each cheap, every step); a good state is snapshotted."""
+        """The guard's checks, every step: one sweep for finite values, speeds and densities
+        (the slower looks that say where run only when it fails), the neighbour counts; a
+        good state is snapshotted."""
         if not self.guard:
             return
+        if not self.scene.state_is_good():
+            self._name_the_bad_value(dt)
+        what = self._check_neighbours()
+        if what:
+            self._blow_up(dt, what)
+        self._snapshot()
+
+    def _name_the_bad_value(self, dt):
+        """Stop with the array, property and particle that failed the guard's sweep."""
         bad = self.scene.check_finite()
         if bad is not None:
             self._blow_up(dt, "non-finite {}.{} at particle {}".format(*bad))
-        # the speed and density sweep only where a limit or a bound asks for it
-        extremes = self.scene.extremes() if self.speed_limit is not None or self.density_bounds else []
-        for what in (self._check_speed(extremes), self._check_density(extremes), self._check_neighbours()):
+        extremes = self.scene.extremes()
+        for what in (self._check_speed(extremes), self._check_density(extremes)):
             if what:
                 self._blow_up(dt, what)
-        self._snapshot()
+        self._blow_up(dt, "the guard's sweep failed, yet no value is non-finite or beyond a limit "
+                          "(report this)")
 
     def _after_step(self, tprev, dt):
         if self.sort_every and self.step % self.sort_every == 0:

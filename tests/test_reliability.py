@@ -17,8 +17,11 @@ import pytest
 from sphgen import io
 from sphgen.threads import ThreadTuner, others_running
 from sphgen.app import load_application, main
-from sphgen.equation import ParameterError
+from sphgen.equation import Equation, Group, ParameterError
 from sphgen.errors import BlowUpError, RestartError
+from sphgen.scene import Scene
+
+from conftest import lattice_cloud
 
 TG = ["run", "taylor_green", "--no-progress", "--nx", "16", "--no-openmp"]
 
@@ -270,3 +273,59 @@ def test_snapshot_restores_every_array_bit_for_bit(tmp_path, backend, nx):
         ((name, speed2, i, rmin, imin, rmax, imax),) = [e for e in solver.scene.extremes() if e[0] == "fluid"]
         assert (name, i) == ("fluid", where) and speed2 == 13.0
         assert (imin, rmin, imax, rmax) == (where, 0.5, fluid.n - 1 - where, 2.0)
+
+
+class ReadState(Equation):
+    """Reads what the guard sweeps: a strided property, the velocity and the density."""
+
+    def initialize(self, d_idx, d_d, d_A, d_u, d_v, d_rho):
+        d_d[d_idx] = d_A[4 * d_idx + 3] + d_u[d_idx] + d_v[d_idx] + d_rho[d_idx]
+
+
+class ReadDensity(Equation):
+    def initialize(self, d_idx, d_e, d_rho):
+        d_e[d_idx] = d_rho[d_idx]
+
+
+@pytest.mark.parametrize("backend", ["cython", "python"])
+def test_state_is_good_finds_every_bad_value_in_one_sweep(backend):
+    """The guard's per-step look (one parallel sweep of every part): a non-finite value of
+    any component of a strided property, a speed above the limit and a density outside its
+    array's own bounds each make it False, wherever the particle lies; a speed exactly at
+    the limit and another array's bounds do not."""
+    fluid = lattice_cloud("fluid", nx=20, seed=1)
+    fluid.add_property("A", stride=4, data=np.random.default_rng(0).uniform(-1, 1, 4 * fluid.n))
+    fluid.add_property("d")
+    wall = lattice_cloud("wall", nx=8, seed=2)
+    wall.y[:] += 1.0
+    wall.add_property("e")
+    sc = Scene([fluid, wall], [Group([ReadState("fluid"), ReadDensity("wall")])], dim=2, threads=2,
+               backend=backend, outputs={"fluid": ["d"], "wall": ["e"]})
+    sc.update_nnps()
+    sc.compute(0, 0.0, 0.0)
+    sc.set_guard_limits(2.0, {"fluid": (0.8, 1.2), "wall": (0.5, 1.5)})
+    assert sc.state_is_good()
+    n = fluid.n
+    for i in (0, n // 2 - 1, n // 2, n - 1):
+        for pa, changes, good in [
+                (fluid, {"A": (4 * i + 3, np.nan)}, False),
+                (fluid, {"A": (4 * i, -np.inf)}, False),
+                (fluid, {"u": (i, np.inf)}, False),
+                (fluid, {"u": (i, 1.5), "v": (i, 1.5)}, False),       # |u| = 2.12 > 2
+                (fluid, {"u": (i, 2.0), "v": (i, 0.0)}, True),        # exactly at the limit
+                (fluid, {"rho": (i, 0.79)}, False),
+                (fluid, {"rho": (i, 1.21)}, False),
+                (wall, {"rho": (i % wall.n, 1.6)}, False),
+                (wall, {"rho": (i % wall.n, 1.4)}, True),             # above the fluid's bound only
+                (wall, {"x": (i % wall.n, np.nan)}, False)]:
+            kept = {p: (k, pa.get(p)[k]) for p, (k, _) in changes.items()}
+            for p, (k, value) in changes.items():
+                pa.get(p)[k] = value
+            assert sc.state_is_good() is good, (backend, pa.name, changes)
+            for p, (k, value) in kept.items():
+                pa.get(p)[k] = value
+            assert sc.state_is_good()
+    sc.set_guard_limits(None, {})
+    fluid.u[3] = 1e6
+    fluid.rho[4] = 1e-6
+    assert sc.state_is_good()           # no limits: only finiteness

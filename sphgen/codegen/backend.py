@@ -71,6 +71,27 @@ class Backend:
             out.append(tuple(row))
         return out
 
+    def set_guard_limits(self, speed_limit, density_bounds):
+        """The limits :meth:`state_is_good` holds the arrays to: the largest speed (None:
+        none) and {array: (smallest rho, largest rho)}."""
+        self._speed2_max = np.inf if speed_limit is None else float(speed_limit) ** 2
+        self._density_bounds = dict(density_bounds)
+
+    def state_is_good(self, arrays):
+        """True when every float is finite and no speed or density is beyond the limits of
+        :meth:`set_guard_limits` (the guard's per-step look; it need not say where)."""
+        for pa, name in self.nonfinite_suspects(arrays):
+            v = pa.data[name]
+            if v.dtype.kind == "f" and not np.isfinite(v).all():
+                return False
+        bounds = getattr(self, "_density_bounds", {})
+        speed2_max = getattr(self, "_speed2_max", np.inf)
+        for name, s2, _, rmin, i, rmax, j in self.extremes(arrays):
+            lo, hi = bounds.get(name, (-np.inf, np.inf))
+            if s2 > speed2_max or (i >= 0 and rmin < lo) or (j >= 0 and rmax > hi):
+                return False
+        return True
+
     def nonfinite_suspects(self, arrays):
         """[(array, property)] that may hold a non-finite value (a cheap first look)."""
         return [(pa, name) for pa in arrays for name in pa.data]

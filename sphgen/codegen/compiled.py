@@ -1,4 +1,6 @@
 """The compiled backend: the plan rendered, built (or loaded from the cache) and driven."""
+import numpy as np
+
 from .backend import Backend
 from .build import load_or_build
 from .render import render
@@ -82,6 +84,18 @@ class CompiledBackend(Backend):
     def extremes(self, arrays):
         self._claim()
         return self.module.extremes()
+
+    def set_guard_limits(self, speed_limit, density_bounds):
+        names = self.module.SWEPT_ARRAYS
+        self._speed2_max = np.inf if speed_limit is None else float(speed_limit) ** 2
+        self._rho_lo = np.array([density_bounds.get(a, (-np.inf, np.inf))[0] for a in names] or [0.0])
+        self._rho_hi = np.array([density_bounds.get(a, (-np.inf, np.inf))[1] for a in names] or [0.0])
+
+    def state_is_good(self, arrays):
+        self._claim()
+        if not hasattr(self, "_rho_lo"):
+            self.set_guard_limits(None, {})
+        return self.module.state_is_good(self._speed2_max, self._rho_lo, self._rho_hi)
 
     def nonfinite_suspects(self, arrays):
         self._claim()

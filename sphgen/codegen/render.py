@@ -178,7 +178,26 @@ def _array_tables(plan):
                  for name, props in alloc],
         scanned=[(name, " + ".join(f"{name}_{u}[i] * {name}_{u}[i]" for u in speed.get(name, ())),
                   props.get("rho") == "double") for name, props in alloc
-                 if name in speed or props.get("rho") == "double"])
+                 if name in speed or props.get("rho") == "double"],
+        swept=_swept_table(plan, alloc, speed))
+
+
+def _swept_table(plan, alloc, speed):
+    """(array, [(stride, non-finite count of value i of the properties of that stride)],
+    its |u|^2 expression or "", whether it has a double rho) per allocated array: what the
+    guard's sweep looks at (stride 1 first, where the speed and density checks join it)."""
+    out = []
+    for name, props in alloc:
+        by_stride = {}
+        for p, t in props.items():
+            if t == "double":
+                by_stride.setdefault(plan.arrays[name].props[p].stride, []).append(p)
+        by_stride.setdefault(1, [])
+        counts = [(st, " + ".join(f"(not isfinite({name}_{p}[i]))" for p in by_stride[st]) or "0")
+                  for st in sorted(by_stride)]
+        out.append((name, counts, " + ".join(f"{name}_{u}[i] * {name}_{u}[i]" for u in speed.get(name, ())),
+                    props.get("rho") == "double"))
+    return out
 
 
 def _parts_table(plan, lists):

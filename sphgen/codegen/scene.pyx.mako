@@ -226,6 +226,47 @@ def stage_${s.name}(double t, double dt):
 
 % endfor
 # ---------------------------------------------------------------- blow-up guard
+# the arrays of state_is_good's density bounds, in the order of its rho_lo and rho_hi
+SWEPT_ARRAYS = (${", ".join(repr(arr) for arr, _, _, _ in swept)}${"," if len(swept) == 1 else ""})
+
+
+def state_is_good(double speed2_max, double[::1] rho_lo, double[::1] rho_hi):
+    """The guard's look after every step, one parallel sweep (thread k over part k of every
+    array): True when every double is finite, no |u|^2 is above ``speed2_max`` and no rho
+    of array SWEPT_ARRAYS[j] lies outside [rho_lo[j], rho_hi[j]].  False only says that
+    something is wrong; count_nonfinite and extremes then say what and where."""
+    cdef long i
+    cdef long bad = 0
+    cdef int k
+    cdef int nt = _nthreads
+    if rho_lo.shape[0] < ${len(swept)} or rho_hi.shape[0] < ${len(swept)}:
+        raise ValueError("state_is_good: one density bound per array of SWEPT_ARRAYS")
+% for j, (arr, counts, speed2, rho) in enumerate(swept):
+% if rho:
+    cdef double lo_${j} = rho_lo[${j}], hi_${j} = rho_hi[${j}]
+% endif
+% endfor
+    with nogil:
+        for k in prange(nt, num_threads=nt, schedule='static'):
+% for j, (arr, counts, speed2, rho) in enumerate(swept):
+% for stride, count in counts:
+            for i in range(_part_${arr}[k] * ${stride}, _part_${arr}[k + 1] * ${stride}):
+                bad += ${count}\
+% if stride == 1 and speed2:
+ + (${speed2} > speed2_max)\
+% endif
+% if stride == 1 and rho:
+ + (${arr}_rho[i] < lo_${j}) + (${arr}_rho[i] > hi_${j})\
+% endif
+
+% endfor
+% endfor
+% if not swept:
+            pass
+% endif
+    return bad == 0
+
+
 def count_nonfinite():
     """[(array, property, count of non-finite values)]: one parallel sweep per array and
     stride counts the values that are not finite (an integer count: the module is built
@@ -340,10 +381,10 @@ def copy_arrays(list arrays, cnp.ndarray out, bint save):
         raise MemoryError("copy_arrays")
     try:
         for j, a in enumerate(arrays):
-            if not (<cnp.ndarray>a).flags['C_CONTIGUOUS']:
+            if not cnp.PyArray_IS_C_CONTIGUOUS(<cnp.ndarray>a):
                 raise TypeError("copy_arrays: needs C-contiguous arrays")
-            nb = (<cnp.ndarray>a).nbytes
-            if total + nb > out.nbytes:
+            nb = cnp.PyArray_NBYTES(<cnp.ndarray>a)
+            if total + nb > cnp.PyArray_NBYTES(out):
                 raise ValueError("copy_arrays: the buffer is too small")
             where[j] = <char*>cnp.PyArray_DATA(<cnp.ndarray>a)
             at[j] = total
