@@ -28,6 +28,7 @@ class CompiledBackend(Backend):
         self._arrays, self._threads = None, 1
         self._bound_lists = None      # the lists the module holds (taken again only if they change)
         self._reference_rows = {}     # key -> row views of a frozen list
+        self._parts = None            # {array: the module's thread parts}, taken at each rebind
 
     def _claim(self):
         if getattr(self.module, "_sphgen_owner", None) is not self and self._arrays is not None:
@@ -37,6 +38,19 @@ class CompiledBackend(Backend):
     def set_threads(self, n):
         self._threads = n
         self.module.set_threads(n)
+        self._parts = self._thread_parts()
+
+    def _thread_parts(self):
+        """{array: int64 thread parts of the module} (for the neighbour search's row cuts)."""
+        if self._arrays is None:
+            return None
+        out = {}
+        for pa in self._arrays:
+            try:
+                out[pa.name] = np.asarray(self.module.parts(pa.name), dtype=np.int64)
+            except KeyError:      # an array no loop of the module walks
+                pass
+        return out
 
     def bind(self, arrays):
         self._arrays = arrays
@@ -50,6 +64,11 @@ class CompiledBackend(Backend):
         if getattr(self.module, "_sphgen_owner", None) is not self and self._arrays is not None:
             return self._claim()     # binds everything, these neighbour lists included
         lists = {}
+        exact = [(key, dest, src) for key, (dest, src, reference) in self.rendered.neighbour_lists.items()
+                 if not reference]
+        # every exact list of this update cut in one call, each row by the thread whose pass walks it
+        for (key, _, _), rows in zip(exact, self.nnps.rows_of([(d, s) for _, d, s in exact], self._parts)):
+            lists[key] = rows[:3]
         for key, (dest, src, reference) in self.rendered.neighbour_lists.items():
             if reference:
                 off, nbrs = self.nnps.reference_neighbours(dest, src)
@@ -57,13 +76,12 @@ class CompiledBackend(Backend):
                 if rows is None or rows[3] is not off or rows[2] is not nbrs:
                     rows = self._reference_rows[key] = (off[:-1], off[1:], nbrs, off)
                 lists[key] = rows[:3]
-            else:
-                lists[key] = self.nnps.rows(dest, src)[:3]
         bound = self._bound_lists
         if bound is None or bound.keys() != lists.keys() or any(
                 any(a is not b for a, b in zip(lists[k], bound[k])) for k in lists):
             self.module.bind_neighbours(lists)    # else the module holds these very arrays
             self._bound_lists = lists
+            self._parts = self._thread_parts()    # the module cut them anew
 
     def run_pass(self, npass, t, dt):
         self._claim()

@@ -20,8 +20,8 @@ import math
 
 import numpy as np
 
-from ._cell_list import (GridSpec, RowBuffers, bin_particles, build_csr, gather_points, largest_motion,
-                          refine_csr, refine_rows, remap_csr, scan, wrap_periodic)
+from ._cell_list import (GridSpec, RowBuffers, bin_particles, build_csr, cut_rows, gather_points,
+                          largest_motion, refine_csr, remap_csr, scan, wrap_periodic)
 
 __all__ = ["Domain", "NeighbourSearch", "NotFrozenError"]
 
@@ -417,36 +417,59 @@ class NeighbourSearch:
         ``nbrs[starts[i]:ends[i]]`` (int32; ``pairs`` in all), for loops that take a row's
         bounds from two arrays, as the generated passes do.  Without a skin these are views
         of the CSR lists.  With one, the rows are cut in place from the skin lists
-        (:func:`refine_rows`): the rows hold the same neighbours in the same order, with
+        (:func:`cut_rows`): the rows hold the same neighbours in the same order, with
         gaps between them, and cost one parallel scan instead of a scan and a compaction.
         Cached until the next update: do not modify the returned arrays."""
-        d, s = self._array(dest), self._array(src)
-        key = (d.name, s.name)
-        rows = self._row_cache.get(key)
-        if rows is not None:
-            return rows
-        if self.skin_distance <= 0 or key in self._cache:
-            off, nbrs = self.neighbours(d, s)
-            rows = (off[:-1], off[1:], nbrs, int(off[-1]))
-        else:
-            rows = self._cut_rows(d, s, self._built_lists(d, s))
-        self._row_cache[key] = rows
-        return rows
+        return self.rows_of([(dest, src)])[0]
 
-    def _cut_rows(self, d, s, lists):
-        """The exact rows of (d, s) now, cut in place from ``lists`` (built with the skin)
-        into buffers kept across updates (the same arrays from step to step while the skin
-        lists stand, so a backend need not take them again)."""
-        key = (d.name, s.name)
-        kept = self._row_buffers.get(key)
-        if kept is None or kept[0] is not lists[0] or kept[2].size < d.n or kept[4].size < lists[1].size:
-            ends = kept[2] if kept is not None and kept[2].size >= d.n else np.empty(max(d.n, 1), np.int32)
-            out = (kept[4] if kept is not None and kept[4].size >= lists[1].size
-                   else np.empty(int(1.25 * lists[1].size) + 16, dtype=np.int32))
-            kept = self._row_buffers[key] = (lists[0], lists[0][:-1], ends, ends[:d.n], out)
-        pairs = refine_rows(self.grid, lists[0], lists[1], self._coords(d), d.get("h"),
-                            self._source_points(s), self.radius_scale, kept[4], kept[2])
-        return kept[1], kept[3], kept[4], int(pairs)
+    def rows_of(self, pairs, parts=None):
+        """:meth:`rows` of every ``(dest, src)`` of ``pairs``; with a skin, those not cut
+        since the update are cut together, in one call.  ``parts`` ({array name: int64
+        thread parts}, optional) says which particles each thread handles (the generated
+        module's parts): each row is then cut by the thread whose pass walks it."""
+        keys = [(self._array(d), self._array(s)) for d, s in pairs]
+        todo = [(d, s) for d, s in keys if (d.name, s.name) not in self._row_cache]
+        if todo:
+            if self.skin_distance <= 0:
+                for d, s in todo:
+                    off, nbrs = self.neighbours(d, s)
+                    self._row_cache[(d.name, s.name)] = (off[:-1], off[1:], nbrs, int(off[-1]))
+            else:
+                cached = [(d, s) for d, s in todo if (d.name, s.name) in self._cache]
+                for d, s in cached:
+                    off, nbrs = self._cache[(d.name, s.name)]
+                    self._row_cache[(d.name, s.name)] = (off[:-1], off[1:], nbrs, int(off[-1]))
+                cut = [(d, s, self._built_lists(d, s)) for d, s in todo if (d.name, s.name) not in self._cache]
+                if cut:
+                    self._row_cache.update(self._cut_rows(cut, parts or {}))
+        return [self._row_cache[(d.name, s.name)] for d, s in keys]
+
+    def _cut_rows(self, todo, parts):
+        """{(dest, src): rows} cut in place from the skin lists of ``todo`` ((d, s, lists)
+        triples) into buffers kept across updates (the same arrays from step to step while
+        the skin lists stand, so a backend need not take them again); the sources' records
+        not gathered since the update are gathered in the same call."""
+        gathers, jobs, kept_of, records = [], [], [], dict(self._points)
+        for d, s, lists in todo:
+            if s.name not in records:
+                buf = self._point_buffers.get(s.name)
+                if buf is None or buf.shape[0] < s.n:
+                    buf = self._point_buffers[s.name] = np.empty((max(s.n, 1), 4), dtype=np.float64)
+                records[s.name] = buf
+                gathers.append((self._coords(s), s.get("h"), buf, parts.get(s.name)))
+            key = (d.name, s.name)
+            kept = self._row_buffers.get(key)
+            if kept is None or kept[0] is not lists[0] or kept[2].size < d.n or kept[4].size < lists[1].size:
+                ends = kept[2] if kept is not None and kept[2].size >= d.n else np.empty(max(d.n, 1), np.int32)
+                out = (kept[4] if kept is not None and kept[4].size >= lists[1].size
+                       else np.empty(int(1.25 * lists[1].size) + 16, dtype=np.int32))
+                kept = self._row_buffers[key] = (lists[0], lists[0][:-1], ends, ends[:d.n], out)
+            jobs.append((lists[0], lists[1], self._coords(d), d.get("h"), records[s.name], kept[4],
+                         kept[2], parts.get(d.name)))
+            kept_of.append((key, kept))
+        pairs = cut_rows(self.grid, jobs, gathers, self.radius_scale)
+        self._points = records
+        return {key: (kept[1], kept[3], kept[4], int(n)) for (key, kept), n in zip(kept_of, pairs)}
 
     def _source_points(self, s):
         """The :func:`gather_points` records of source ``s``, gathered once per update."""

@@ -909,18 +909,28 @@ def gather_points(list coords, double[::1] h, double radius_scale, double[:, ::1
     cdef Py_ssize_t n = h.shape[0], i
     cdef int a, dim = len(coords)
     cdef const double* x[3]
-    cdef double kh
     if out.shape[0] < n or out.shape[1] != 4:
         raise ValueError("gather_points: out must have (n, 4) entries")
-    for a in range(dim):
-        x[a] = _coord_ptr(coords[a], n)
+    for a in range(3):
+        x[a] = _coord_ptr(coords[a], n) if a < dim else NULL
+    if n == 0:
+        return out
+    cdef double* po = &out[0, 0]
+    cdef const double* ph = &h[0]
     # static parts, as the stages that wrote x: each thread gathers its own particles
     for i in prange(n, nogil=True, schedule="static"):
-        for a in range(3):
-            out[i, a] = x[a][i] if a < dim else 0.0
-        kh = radius_scale * h[i]
-        out[i, 3] = kh * kh
+        _record(po, x, ph, i, radius_scale)
     return out
+
+
+cdef inline void _record(double* out, const double** x, const double* h, Py_ssize_t i,
+                         double radius_scale) noexcept nogil:
+    """Source record i of :func:`gather_points`: (x, y, z, (k h)**2), 0 on missing axes."""
+    cdef int a
+    cdef double kh = radius_scale * h[i]
+    for a in range(3):
+        out[4 * i + a] = x[a][i] if x[a] != NULL else 0.0
+    out[4 * i + 3] = kh * kh
 
 
 cdef inline Py_ssize_t _refine_row(const Grid* g, bint open_box, Py_ssize_t i, const int* nbrs,
@@ -972,53 +982,136 @@ cdef inline Py_ssize_t _refine_row(const Grid* g, bint open_box, Py_ssize_t i, c
     return cnt
 
 
-def refine_rows(GridSpec grid, int[::1] offsets, int[::1] nbrs, list dest_coords,
-                double[::1] dest_h, double[:, ::1] src_points, double radius_scale,
-                int[::1] out, int[::1] ends):
-    """The exact lists (``|r_ij| < k max(h_i, h_j)`` now) cut from lists with a skin,
-    as rows in place: row ``i`` is ``out[offsets[i]:ends[i]]``.
+ctypedef struct CutJob:
+    const int* off       # the skin list: offsets and candidates
+    const int* nbrs
+    const double* xd[3]  # the destination's coordinates now
+    const double* h
+    const double* pts    # the source's records (gather_points)
+    int* out             # the rows, in place: row i is out[off[i]:ends[i]]
+    int* ends
+    Py_ssize_t nd
+    const long* parts    # thread k cuts rows parts[k] .. parts[k+1]-1 (NULL: equal parts)
 
-    ``offsets``/``nbrs`` hold, for every destination, a superset of its neighbours (a
-    list built with a skin that still covers the motion); the coordinates and ``h`` are
-    the current ones, the sources' as the records of :func:`gather_points` (gathered once
-    per update and shared by every list with that source).  Each row keeps its order and
-    equals the row of a fresh exact build.  One parallel scan: no compaction, no
-    allocation (``out`` needs ``len(nbrs)`` entries, ``ends`` one per destination).
-    Returns the number of pairs."""
+
+ctypedef struct GatherJob:
+    const double* x[3]
+    const double* h
+    double* out
+    Py_ssize_t n
+    const long* parts
+
+
+cdef inline void _part(const long* parts, Py_ssize_t n, int k, int nt, Py_ssize_t* lo,
+                       Py_ssize_t* hi) noexcept nogil:
+    """Thread k's items of n: ``parts`` (cut by the generated module) or equal counts."""
+    if parts != NULL:
+        lo[0] = parts[k]
+        hi[0] = parts[k + 1]
+    else:
+        lo[0] = n * k // nt
+        hi[0] = n * (k + 1) // nt
+
+
+cdef const long* _parts_ptr(object parts, Py_ssize_t n, int nt) except? NULL:
+    """The int64 thread parts of n items if they cut all of them into nt, else NULL."""
+    cdef const long[::1] v
+    if parts is None:
+        return NULL
+    v = parts
+    if v.shape[0] != nt + 1 or v[0] != 0 or v[nt] != n:
+        return NULL
+    return &v[0]
+
+
+def cut_rows(GridSpec grid, list jobs, list gathers, double radius_scale):
+    """The exact lists (``|r_ij| < k max(h_i, h_j)`` now) of several (dest, src) pairs, cut
+    from their lists with a skin, as rows in place; returns the number of pairs of each.
+
+    ``gathers``: ``(coords, h, out, parts)`` per source whose records (:func:`gather_points`)
+    are not gathered yet; ``jobs``: ``(offsets, nbrs, dest_coords, dest_h, src_points, out,
+    ends, parts)`` per list: the skin list, the destination now, the source's records, and
+    where the rows go (row ``i`` is ``out[offsets[i]:ends[i]]``; ``out`` needs ``len(nbrs)``
+    entries, ``ends`` one per destination).  Each row keeps its order and equals the row of
+    a fresh exact build.  ``parts`` (int64, one more than the threads, or None) say which
+    particles thread k handles: the generated module's thread parts, so that each row is
+    cut, and each record gathered, by the thread that wrote those particles and walks those
+    rows.  Two parallel regions in all (the records, then every list), one Python call."""
     cdef const Grid* g = &grid.c
-    cdef Py_ssize_t nd = dest_h.shape[0], i, cnt, total = 0
-    cdef const double* xd[3]
+    cdef int nt = max(1, min(sphgen_max_threads(), 64))
+    cdef Py_ssize_t nj = len(jobs), ng = len(gathers), j, i, lo, hi, cnt
+    cdef int a, k
     cdef double kh
-    cdef int a
-    cdef int* po = _iptr(out)
-    cdef const int* pn = _iptr(nbrs)
-    cdef const double* pts = &src_points[0, 0] if src_points.shape[0] else NULL
-    if (offsets.shape[0] != nd + 1 or out.shape[0] < nbrs.shape[0] or ends.shape[0] < nd
-            or src_points.shape[1] != 4):
-        raise ValueError("refine_rows: the list does not fit the arrays")
-    for a in range(3):
-        xd[a] = _coord_ptr(dest_coords[a], nd) if a < g.dim else NULL
     cdef bint open_box = g.dim >= 2 and not (g.periodic[0] or g.periodic[1] or g.periodic[2])
-    # static halves, as the passes over a destination that is among its sources: each row
-    # is cut by the thread whose pass then walks it (dynamic chunks, which balance a wall
-    # list's uneven rows better, moved the rows between cores and cost more than they saved)
-    for i in prange(nd, nogil=True, schedule="static"):
-        kh = radius_scale * dest_h[i]
-        cnt = _refine_row(g, open_box, i, pn, offsets[i], offsets[i + 1], xd[0], xd[1], xd[2],
-                          kh * kh, pts, po + offsets[i])
-        ends[i] = <int>(offsets[i] + cnt)
-        total += cnt
-    return total
+    cdef CutJob* cj = <CutJob*>malloc((nj + 1) * sizeof(CutJob))
+    cdef GatherJob* gj = <GatherJob*>malloc((ng + 1) * sizeof(GatherJob))
+    cdef Py_ssize_t* found = <Py_ssize_t*>malloc((nj * nt + 1) * sizeof(Py_ssize_t))
+    cdef int[::1] off, nbrs, out, ends
+    cdef double[::1] h
+    cdef double[:, ::1] pts
+    keep = []             # the memoryviews behind the pointers, alive through the call
+    try:
+        if cj == NULL or gj == NULL or found == NULL:
+            raise MemoryError("cut_rows")
+        for j in range(ng):
+            coords, h, pts, parts = gathers[j]
+            if pts.shape[0] < h.shape[0] or pts.shape[1] != 4:
+                raise ValueError("cut_rows: a source's records need (n, 4) entries")
+            gj[j].n = h.shape[0]
+            for a in range(3):
+                gj[j].x[a] = _coord_ptr(coords[a], gj[j].n) if a < len(coords) else NULL
+            gj[j].h = &h[0] if gj[j].n else NULL
+            gj[j].out = &pts[0, 0] if pts.shape[0] else NULL
+            gj[j].parts = _parts_ptr(parts, gj[j].n, nt)
+            keep.append((h, pts, parts))
+        for j in range(nj):
+            off, nbrs, coords, h, pts, out, ends, parts = jobs[j]
+            cj[j].nd = h.shape[0]
+            if (off.shape[0] != cj[j].nd + 1 or out.shape[0] < nbrs.shape[0] or ends.shape[0] < cj[j].nd
+                    or pts.shape[1] != 4):
+                raise ValueError("cut_rows: the list does not fit the arrays")
+            cj[j].off = _iptr(off)
+            cj[j].nbrs = _iptr(nbrs)
+            for a in range(3):
+                cj[j].xd[a] = _coord_ptr(coords[a], cj[j].nd) if a < g.dim else NULL
+            cj[j].h = &h[0] if cj[j].nd else NULL
+            cj[j].pts = &pts[0, 0] if pts.shape[0] else NULL
+            cj[j].out = _iptr(out)
+            cj[j].ends = _iptr(ends)
+            cj[j].parts = _parts_ptr(parts, cj[j].nd, nt)
+            keep.append((off, nbrs, h, pts, out, ends, parts))
+        if ng:
+            for k in prange(nt, nogil=True, schedule="static", num_threads=nt):
+                for j in range(ng):
+                    _part(gj[j].parts, gj[j].n, k, nt, &lo, &hi)
+                    for i in range(lo, hi):
+                        _record(gj[j].out, gj[j].x, gj[j].h, i, radius_scale)
+        for k in prange(nt, nogil=True, schedule="static", num_threads=nt):
+            for j in range(nj):
+                _part(cj[j].parts, cj[j].nd, k, nt, &lo, &hi)
+                found[j * nt + k] = 0
+                for i in range(lo, hi):
+                    kh = radius_scale * cj[j].h[i]
+                    cnt = _refine_row(g, open_box, i, cj[j].nbrs, cj[j].off[i], cj[j].off[i + 1],
+                                      cj[j].xd[0], cj[j].xd[1], cj[j].xd[2], kh * kh, cj[j].pts,
+                                      cj[j].out + cj[j].off[i])
+                    cj[j].ends[i] = <int>(cj[j].off[i] + cnt)
+                    found[j * nt + k] = found[j * nt + k] + cnt
+        return [sum(found[j * nt + k] for k in range(nt)) for j in range(nj)]
+    finally:
+        free(cj)
+        free(gj)
+        free(found)
 
 
 def refine_csr(GridSpec grid, int[::1] offsets, int[::1] nbrs, list dest_coords,
                double[::1] dest_h, double[:, ::1] src_points, double radius_scale,
                int[::1] scratch):
-    """The exact lists as compact CSR ``(offsets, nbrs)``: :func:`refine_rows` into
+    """The exact lists as compact CSR ``(offsets, nbrs)``: :func:`cut_rows` into
     ``scratch`` (``len(nbrs)`` entries), then the rows packed."""
     cdef Py_ssize_t nd = dest_h.shape[0], i
     cdef int[::1] counts = np.empty(nd, dtype=np.int32)
-    refine_rows(grid, offsets, nbrs, dest_coords, dest_h, src_points, radius_scale, scratch, counts)
+    cut_rows(grid, [(offsets, nbrs, dest_coords, dest_h, src_points, scratch, counts, None)], [], radius_scale)
     for i in range(nd):
         counts[i] -= offsets[i]
     return _compact(offsets, counts, _iptr(scratch), nd)
