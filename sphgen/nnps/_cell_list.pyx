@@ -1013,6 +1013,21 @@ cdef inline void _part(const long* parts, Py_ssize_t n, int k, int nt, Py_ssize_
         hi[0] = n * (k + 1) // nt
 
 
+cdef Py_ssize_t _cut_part(const Grid* g, bint open_box, CutJob* job, Py_ssize_t lo, Py_ssize_t hi,
+                          double radius_scale) noexcept nogil:
+    """The rows lo..hi-1 of one :func:`cut_rows` list; returns their pairs (counted in a
+    local: a shared per-thread slot written per row would bounce between the cores)."""
+    cdef Py_ssize_t i, cnt, total = 0
+    cdef double kh
+    for i in range(lo, hi):
+        kh = radius_scale * job.h[i]
+        cnt = _refine_row(g, open_box, i, job.nbrs, job.off[i], job.off[i + 1], job.xd[0], job.xd[1],
+                          job.xd[2], kh * kh, job.pts, job.out + job.off[i])
+        job.ends[i] = <int>(job.off[i] + cnt)
+        total += cnt
+    return total
+
+
 cdef const long* _parts_ptr(object parts, Py_ssize_t n, int nt) except? NULL:
     """The int64 thread parts of n items if they cut all of them into nt, else NULL."""
     cdef const long[::1] v
@@ -1089,14 +1104,7 @@ def cut_rows(GridSpec grid, list jobs, list gathers, double radius_scale):
         for k in prange(nt, nogil=True, schedule="static", num_threads=nt):
             for j in range(nj):
                 _part(cj[j].parts, cj[j].nd, k, nt, &lo, &hi)
-                found[j * nt + k] = 0
-                for i in range(lo, hi):
-                    kh = radius_scale * cj[j].h[i]
-                    cnt = _refine_row(g, open_box, i, cj[j].nbrs, cj[j].off[i], cj[j].off[i + 1],
-                                      cj[j].xd[0], cj[j].xd[1], cj[j].xd[2], kh * kh, cj[j].pts,
-                                      cj[j].out + cj[j].off[i])
-                    cj[j].ends[i] = <int>(cj[j].off[i] + cnt)
-                    found[j * nt + k] = found[j * nt + k] + cnt
+                found[j * nt + k] = _cut_part(g, open_box, &cj[j], lo, hi, radius_scale)
         return [sum(found[j * nt + k] for k in range(nt)) for j in range(nj)]
     finally:
         free(cj)
