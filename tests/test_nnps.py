@@ -456,7 +456,8 @@ def _drift(pa, dim, step, scale):
 def test_skin_gives_the_exact_lists_and_rebuilds_only_when_needed(dim, periodic, threads,
                                                                    monkeypatch):
     """Lists cut from a skin list equal a fresh exact build (and brute force), entry for
-    entry, through motion, growth of h, rebuilds and reuse; two arrays, variable h."""
+    entry, through motion, growth of h, rebuilds and reuse; two arrays, variable h; one
+    list at a time or all at once with thread parts."""
     monkeypatch.setenv("OMP_NUM_THREADS", str(threads))
     rng = np.random.default_rng(40 + dim)
     n = {1: 150, 2: 500, 3: 800}[dim]
@@ -473,8 +474,13 @@ def test_skin_gives_the_exact_lists_and_rebuilds_only_when_needed(dim, periodic,
             group[1].get("h")[:] *= 1.0005
         with_skin.update()
         fresh.update()
-        for d, s in (("f", "f"), ("f", "w"), ("w", "f")):
-            starts, ends, nbrs, pairs = with_skin.rows(d, s)     # cut in place, with gaps
+        keys = (("f", "f"), ("f", "w"), ("w", "f"))
+        if step % 2:      # all three lists in one call, the rows cut by uneven thread parts
+            parts = {"f": np.array([0, n // 3, n]), "w": np.array([0, 2 * n // 3, n])}
+            together = dict(zip(keys, with_skin.rows_of(keys, parts)))
+        for d, s in keys:
+            # cut in place, with gaps
+            starts, ends, nbrs, pairs = together[(d, s)] if step % 2 else with_skin.rows(d, s)
             assert_same_lists(packed(starts, ends, nbrs), fresh.neighbours(d, s))
             assert pairs == fresh.pair_totals()[(d, s)]
             assert_same_lists(with_skin.neighbours(d, s), fresh.neighbours(d, s))

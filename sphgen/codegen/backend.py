@@ -18,6 +18,7 @@ class Backend:
     def __init__(self, plan, nnps):
         self.plan = plan
         self.nnps = nnps
+        self.set_guard_limits(None, {})
 
     def set_threads(self, n):
         """Threads of the parallel loops."""
@@ -84,11 +85,9 @@ class Backend:
             v = pa.data[name]
             if v.dtype.kind == "f" and not np.isfinite(v).all():
                 return False
-        bounds = getattr(self, "_density_bounds", {})
-        speed2_max = getattr(self, "_speed2_max", np.inf)
         for name, s2, _, rmin, i, rmax, j in self.extremes(arrays):
-            lo, hi = bounds.get(name, (-np.inf, np.inf))
-            if s2 > speed2_max or (i >= 0 and rmin < lo) or (j >= 0 and rmax > hi):
+            lo, hi = self._density_bounds.get(name, (-np.inf, np.inf))
+            if s2 > self._speed2_max or (i >= 0 and rmin < lo) or (j >= 0 and rmax > hi):
                 return False
         return True
 

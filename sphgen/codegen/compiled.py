@@ -18,10 +18,10 @@ class CompiledBackend(Backend):
     name = "cython"
 
     def __init__(self, plan, nnps):
-        super().__init__(plan, nnps)
         self.rendered = render(plan)
         self.source = self.rendered.source
         self.module, self.compile_time = load_or_build(self.source, self.rendered.origin)
+        super().__init__(plan, nnps)
         self.source_path = self.module.__sphgen_source__
         self._passes = {k: getattr(self.module, v) for k, v in self.rendered.pass_entries.items()}
         self._stages = {k: getattr(self.module, v) for k, v in self.rendered.stage_entries.items()}
@@ -111,8 +111,6 @@ class CompiledBackend(Backend):
 
     def state_is_good(self, arrays):
         self._claim()
-        if not hasattr(self, "_rho_lo"):
-            self.set_guard_limits(None, {})
         return self.module.state_is_good(self._speed2_max, self._rho_lo, self._rho_hi)
 
     def nonfinite_suspects(self, arrays):
