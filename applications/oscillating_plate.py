@@ -30,6 +30,7 @@ import numpy as np
 from sphgen import io
 from sphgen.app import Application
 from sphgen.errors import InputError
+from sphgen.kernels import KERNELS
 from sphgen.geometry import rectangle
 from sphgen.particles import ParticleArray
 from sphgen.tools.plots import particle_panels
@@ -83,6 +84,19 @@ def sparse_particles(x, y, dx):
     return int(np.sum(counts < 0.5 * 21))   # 21: a square lattice's bulk count, itself included
 
 
+def parse_p_ref(text):
+    """--p-ref: None, 'body' or a positive pressure."""
+    if text is None or text == "body":
+        return text
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not (math.isfinite(value) and value > 0):
+        raise InputError(f"--p-ref must be a positive pressure or 'body', got {text!r}")
+    return value
+
+
 class OscillatingPlate(Application):
     """Clamped elastic plate in bending: CTVF (default) or GTVF, SPST/IPST/GTVF shifting."""
 
@@ -114,6 +128,12 @@ class OscillatingPlate(Application):
         group.add_argument("--nh", type=int, default=10, help="particles across H (paper: 10, dx = 2 mm)")
         group.add_argument("--clamp-layers", type=int, default=3, help="clamped columns left of x = 0 (default 3)")
         group.add_argument("--alpha", type=float, default=1.0, help="artificial viscosity (paper: 1)")
+        group.add_argument("--kernel", choices=KERNELS, default="quintic",
+                           help="smoothing kernel of every equation (default %(default)s)")
+        group.add_argument("--hdx", type=float, default=1.0, help="h / dx (default %(default)s)")
+        group.add_argument("--p-ref", default=None,
+                           help="gtvf shifting: the cap of p0 = min(10|p|, p_ref), a pressure in Pa or "
+                           "'body' (the body's largest |p| each step); default rho0 c0^2")
         group.add_argument("--separation-time", type=float, default=0.22,
                            help="report separation up to this time too (paper, Figs. 18-19: 0.22 s)")
         group.add_argument("--record-every", type=float, default=5e-4, help="time between samples (s)")
@@ -131,6 +151,9 @@ class OscillatingPlate(Application):
             raise InputError("--no-corrections applies to --scheme ctvf only")
         if not (0 <= o.perturb < 0.5):
             raise InputError(f"--perturb must be in [0, 0.5), got {o.perturb}")
+        if not (math.isfinite(o.hdx) and o.hdx > 0):
+            raise InputError(f"--hdx must be a positive number, got {o.hdx}")
+        self.p_ref = parse_p_ref(o.p_ref)
         self.dx = o.height / o.nh
         self.c0, _ = elastic_constants(E, POISSON, RHO0)
         self.shifting = o.shifting or ("spst" if o.scheme == "ctvf" else "gtvf")
@@ -152,7 +175,7 @@ class OscillatingPlate(Application):
                      / mode_shape(o.length, o.length), 0.0)
         n = x.size
         plate = ParticleArray("plate", x=x, y=y, v=v, rho=np.full(n, RHO0), m=np.full(n, RHO0 * dx * dx),
-                              h=np.full(n, dx))
+                              h=np.full(n, o.hdx * dx))
         self.clamp_gids = np.flatnonzero(x0 < 0)
         xt = x0.max()
         self.tip = MaterialPoints("plate", gids=np.flatnonzero((x0 == xt) & (np.abs(y0) < 0.6 * dx)))
@@ -164,7 +187,7 @@ class OscillatingPlate(Application):
 
     def create_scheme(self):
         o = self.options
-        common = dict(h=self.dx, dx=self.dx, umax=o.vf * self.c0, shifting=self.shifting, alpha=o.alpha,
+        common = dict(h=o.hdx * self.dx, dx=self.dx, kernel=o.kernel, p_ref=self.p_ref, umax=o.vf * self.c0, shifting=self.shifting, alpha=o.alpha,
                       clamped={"plate": self.clamp_gids}, free_surface=self.free_surface,
                       surface_pressure=o.surface_pressure)
         if o.scheme == "gtvf":

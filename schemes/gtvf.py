@@ -72,8 +72,13 @@ class GTVFScheme(TransportVelocityScheme):
                        Group([CorrectedSummationDensity(d, self._sources(d)) for d in self.fluids])]
         else:
             groups.append(Group([SummationDensity(d, self._sources(d)) for d in self.fluids]))
-        groups.append(Group([TaitEOS(d, rho0=self.rho0, c0=self.c0, gamma=1.0) for d in self.fluids]))
+        groups.append(self._eos_group())
         return groups
+
+    def _eos_group(self):
+        """p = c0^2 (rho - rho0), then (p_ref 'body') the body's largest |p|, the cap of p0."""
+        eqs = [TaitEOS(d, rho0=self.rho0, c0=self.c0, gamma=1.0) for d in self.fluids]
+        return Group(eqs + [e for d in self.fluids for e in self.shift.pressure_equations(d)])
 
     def _momentum_group(self):
         """Zhang et al. eq. 17: pressure gradient, transport stress, viscosity, (du/dt)_c."""
@@ -117,4 +122,4 @@ class GTVFSolidScheme(ElasticSolids, GTVFScheme):
 
     def _density_groups(self):
         """p = c0^2 (rho - rho0), rho from the continuity equation."""
-        return [Group([TaitEOS(d, rho0=self.rho0, c0=self.c0, gamma=1.0) for d in self.fluids])]
+        return [self._eos_group()]
