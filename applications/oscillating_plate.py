@@ -7,8 +7,12 @@ across), Monaghan artificial viscosity alpha = 1, starts straight with the veloc
 eq. 67: v_y = V_f c0 F(x) / F(L), kL = 1.875.  The clamp: the plate continues
 ``--clamp-layers`` columns to the left of x = 0, held at u = u~ = 0 by the integrator
 (its particles keep their stress and pressure equations, so the plate sees a full
-kernel support at x = 0).  ``--scheme`` ctvf (default, SPST; the paper's Figs. 19-21) or
-gtvf (its homogenisation, Fig. 18a; ``--shifting spst`` for Fig. 18b).
+kernel support at x = 0); ``--clamp wall`` (gtvf) leaves those columns free inside fixed
+wall particles above, below and behind them.  ``--scheme`` ctvf (default, SPST; the
+paper's Figs. 19-21) or gtvf (its homogenisation, Fig. 18a; ``--shifting spst`` for Fig.
+18b).  ``--kernel``, ``--hdx`` (default the quintic at h = dx; the GTVF plate stays whole
+only at h = 1.3 dx, docs/ctvf.md "Fig. 18a"), ``--p-ref`` (gtvf: the cap of p0, a
+pressure or 'body', the body's largest |p|).
 
 ``results.json``: the period of the tip (the midpoint of the two end particles on the
 centre line, followed by id: :class:`sphgen.tools.probes.MaterialPoints`) from its zero
@@ -211,7 +215,8 @@ class OscillatingPlate(Application):
 
     def create_scheme(self):
         o = self.options
-        common = dict(h=o.hdx * self.dx, dx=self.dx, kernel=o.kernel, p_ref=self.p_ref, umax=o.vf * self.c0, shifting=self.shifting, alpha=o.alpha,
+        common = dict(h=o.hdx * self.dx, dx=self.dx, kernel=o.kernel, p_ref=self.p_ref, umax=o.vf * self.c0,
+                      shifting=self.shifting, alpha=o.alpha,
                       clamped={"plate": self.clamp_gids}, free_surface=self.free_surface,
                       surface_pressure=o.surface_pressure)
         if o.scheme == "gtvf":
