@@ -157,6 +157,8 @@ class OscillatingPlate(Application):
             raise InputError("--nh must be at least 4 and --clamp-layers at least 1")
         if o.clamp == "wall" and o.scheme != "gtvf":
             raise InputError("--clamp wall applies to --scheme gtvf only")
+        if o.p_ref is not None and o.scheme != "gtvf":
+            raise InputError("--p-ref applies to --scheme gtvf only")
         if o.no_corrections and o.scheme != "ctvf":
             raise InputError("--no-corrections applies to --scheme ctvf only")
         if not (0 <= o.perturb < 0.5):

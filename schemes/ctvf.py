@@ -175,6 +175,9 @@ class TransportVelocityScheme(Scheme):
         self.shift = Shifting(shifting, self.dim, h, dx, c0, umax, self.kernel, rho0=rho0, mach=mach,
                               pb=pb, p_ref=p_ref, ipst_tolerance=ipst_tolerance,
                               ipst_max_iterations=ipst_max_iterations, ipst_interval=ipst_interval)
+        if self.shift.body_cap and not callable(getattr(self, "_eos_group", None)):
+            raise ValueError(f"{type(self).__name__}: p_ref='body' needs the body's largest |p| after the "
+                             "equation of state, which only the GTVF schemes compute")
         if surface_pressure and not free_surface:
             raise ValueError("surface_pressure needs free_surface=True")
         self.free_surface, self.surface_pressure = bool(free_surface), bool(surface_pressure)

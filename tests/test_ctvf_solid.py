@@ -323,8 +323,12 @@ def test_plate_clamp_of_wall_particles(tmp_path):
 
 
 def test_plate_options_reject_nonsense(tmp_path, capsys):
-    """One clear line for each: --clamp wall with ctvf, a bad --p-ref, --hdx 0."""
-    for args in (("--clamp", "wall"), ("--p-ref", "-3"), ("--p-ref", "high"), ("--hdx", "0")):
+    """One clear line for each: --clamp wall or --p-ref with ctvf, a bad --p-ref, --hdx 0;
+    the CTVF scheme refuses p_ref 'body' (nothing would set the cap)."""
+    with pytest.raises(ValueError, match="p_ref='body'"):
+        CTVFSolidScheme(["plate"], 2, 1000.0, 2e6, 0.3, h=0.002, dx=0.002, shifting="gtvf", p_ref="body")
+    for args in (("--clamp", "wall"), ("--p-ref", "body"), ("--p-ref", "-3", "--scheme", "gtvf"),
+                 ("--p-ref", "high", "--scheme", "gtvf"), ("--hdx", "0")):
         with pytest.raises(SystemExit):
             run_app("oscillating_plate", tmp_path, "--nh", "4", "--tf", "0.001", *args)
         err = capsys.readouterr().err
