@@ -7,8 +7,12 @@ across), Monaghan artificial viscosity alpha = 1, starts straight with the veloc
 eq. 67: v_y = V_f c0 F(x) / F(L), kL = 1.875.  The clamp: the plate continues
 ``--clamp-layers`` columns to the left of x = 0, held at u = u~ = 0 by the integrator
 (its particles keep their stress and pressure equations, so the plate sees a full
-kernel support at x = 0).  ``--scheme`` ctvf (default, SPST; the paper's Figs. 19-21) or
-gtvf (its homogenisation, Fig. 18a; ``--shifting spst`` for Fig. 18b).
+kernel support at x = 0); ``--clamp wall`` (gtvf) leaves those columns free inside fixed
+wall particles above, below and behind them.  ``--scheme`` ctvf (default, SPST; the
+paper's Figs. 19-21) or gtvf (its homogenisation, Fig. 18a; ``--shifting spst`` for Fig.
+18b).  ``--kernel``, ``--hdx`` (default the quintic at h = dx; the GTVF plate stays whole
+only at h = 1.3 dx, docs/ctvf.md "Fig. 18a"), ``--p-ref`` (gtvf: the cap of p0, a
+pressure or 'body', the body's largest |p|).
 
 ``results.json``: the period of the tip (the midpoint of the two end particles on the
 centre line, followed by id: :class:`sphgen.tools.probes.MaterialPoints`) from its zero
@@ -30,6 +34,7 @@ import numpy as np
 from sphgen import io
 from sphgen.app import Application
 from sphgen.errors import InputError
+from sphgen.kernels import KERNELS, get_kernel
 from sphgen.geometry import rectangle
 from sphgen.particles import ParticleArray
 from sphgen.tools.plots import particle_panels
@@ -47,6 +52,7 @@ PERIOD_PAPER = {0.001: 0.284, 0.01: 0.283, 0.03: 0.283, 0.05: 0.284}
 SCHEMES = ("ctvf", "gtvf")
 BOND = 1.5            # bond / piece radius, in dx
 NEIGHBOUR_RADIUS = 2.5
+CLAMPS = ("held", "wall")
 GAP_CRACK = 1.0       # bond gap (in dx) of a separation: a hole a whole particle fits into
 
 
@@ -83,6 +89,19 @@ def sparse_particles(x, y, dx):
     return int(np.sum(counts < 0.5 * 21))   # 21: a square lattice's bulk count, itself included
 
 
+def parse_p_ref(text):
+    """--p-ref: None, 'body' or a positive pressure."""
+    if text is None or text == "body":
+        return text
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not (math.isfinite(value) and value > 0):
+        raise InputError(f"--p-ref must be a positive pressure or 'body', got {text!r}")
+    return value
+
+
 class OscillatingPlate(Application):
     """Clamped elastic plate in bending: CTVF (default) or GTVF, SPST/IPST/GTVF shifting."""
 
@@ -113,7 +132,16 @@ class OscillatingPlate(Application):
         group.add_argument("--height", type=float, default=0.02, help="H (default %(default)s m)")
         group.add_argument("--nh", type=int, default=10, help="particles across H (paper: 10, dx = 2 mm)")
         group.add_argument("--clamp-layers", type=int, default=3, help="clamped columns left of x = 0 (default 3)")
+        group.add_argument("--clamp", choices=CLAMPS, default="held",
+                           help="held: the clamp columns are held at u = u~ = 0 (default); wall (gtvf): "
+                           "they are free, inside fixed wall particles above, below and behind them")
         group.add_argument("--alpha", type=float, default=1.0, help="artificial viscosity (paper: 1)")
+        group.add_argument("--kernel", choices=KERNELS, default="quintic",
+                           help="smoothing kernel of every equation (default %(default)s)")
+        group.add_argument("--hdx", type=float, default=1.0, help="h / dx (default %(default)s)")
+        group.add_argument("--p-ref", default=None,
+                           help="gtvf shifting: the cap of p0 = min(10|p|, p_ref), a pressure in Pa or "
+                           "'body' (the body's largest |p| each step); default rho0 c0^2")
         group.add_argument("--separation-time", type=float, default=0.22,
                            help="report separation up to this time too (paper, Figs. 18-19: 0.22 s)")
         group.add_argument("--record-every", type=float, default=5e-4, help="time between samples (s)")
@@ -127,10 +155,17 @@ class OscillatingPlate(Application):
                 raise InputError(f"--{name.replace('_', '-')} must be a positive number, got {v}")
         if o.nh < 4 or o.clamp_layers < 1:
             raise InputError("--nh must be at least 4 and --clamp-layers at least 1")
+        if o.clamp == "wall" and o.scheme != "gtvf":
+            raise InputError("--clamp wall applies to --scheme gtvf only")
+        if o.p_ref is not None and o.scheme != "gtvf":
+            raise InputError("--p-ref applies to --scheme gtvf only")
         if o.no_corrections and o.scheme != "ctvf":
             raise InputError("--no-corrections applies to --scheme ctvf only")
         if not (0 <= o.perturb < 0.5):
             raise InputError(f"--perturb must be in [0, 0.5), got {o.perturb}")
+        if not (math.isfinite(o.hdx) and o.hdx > 0):
+            raise InputError(f"--hdx must be a positive number, got {o.hdx}")
+        self.p_ref = parse_p_ref(o.p_ref)
         self.dx = o.height / o.nh
         self.c0, _ = elastic_constants(E, POISSON, RHO0)
         self.shifting = o.shifting or ("spst" if o.scheme == "ctvf" else "gtvf")
@@ -152,23 +187,43 @@ class OscillatingPlate(Application):
                      / mode_shape(o.length, o.length), 0.0)
         n = x.size
         plate = ParticleArray("plate", x=x, y=y, v=v, rho=np.full(n, RHO0), m=np.full(n, RHO0 * dx * dx),
-                              h=np.full(n, dx))
-        self.clamp_gids = np.flatnonzero(x0 < 0)
+                              h=np.full(n, o.hdx * dx))
+        self.clamp_gids = np.flatnonzero(x0 < 0) if o.clamp == "held" else np.array([], dtype=int)
         xt = x0.max()
         self.tip = MaterialPoints("plate", gids=np.flatnonzero((x0 == xt) & (np.abs(y0) < 0.6 * dx)))
         i, j, _ = pairs_within((x0, y0), (x0, y0), 1.01 * dx)
         keep = i < j
         self.bonds = np.column_stack([i[keep], j[keep]])        # gids = initial indices
         self.sparse0 = sparse_particles(x, y, dx)
+        if o.clamp == "wall":
+            return [plate, self.clamp_wall(x0.min(), y0.min(), y0.max())]
         return [plate]
+
+    def clamp_wall(self, xmin, ymin, ymax):
+        """Fixed particles, as many layers as the kernel's support (in dx), above and below
+        the clamp columns (x < 0) and behind them over the whole height (the public GTVF
+        plate script's clamp, there around L/4 of the plate)."""
+        o, dx = self.options, self.dx
+        n = math.ceil(get_kernel(o.kernel, 2).radius_scale * o.hdx - 1e-9)
+        cols = np.arange(xmin, 0.0, dx)
+        rows = np.concatenate([ymax + dx * np.arange(1, n + 1), ymin - dx * np.arange(1, n + 1)])
+        xa, ya = (a.ravel() for a in np.meshgrid(cols, rows, indexing="ij"))
+        xb, yb = (a.ravel() for a in np.meshgrid(xmin - dx * np.arange(1, n + 1),
+                                                 np.arange(ymin - n * dx, ymax + (n + 0.5) * dx, dx), indexing="ij"))
+        x, y = np.concatenate([xa, xb]), np.concatenate([ya, yb])
+        k = x.size
+        return ParticleArray("wall", x=x, y=y, rho=np.full(k, RHO0), m=np.full(k, RHO0 * dx * dx),
+                             h=np.full(k, o.hdx * dx))
 
     def create_scheme(self):
         o = self.options
-        common = dict(h=self.dx, dx=self.dx, umax=o.vf * self.c0, shifting=self.shifting, alpha=o.alpha,
+        common = dict(h=o.hdx * self.dx, dx=self.dx, kernel=o.kernel, p_ref=self.p_ref, umax=o.vf * self.c0,
+                      shifting=self.shifting, alpha=o.alpha,
                       clamped={"plate": self.clamp_gids}, free_surface=self.free_surface,
                       surface_pressure=o.surface_pressure)
         if o.scheme == "gtvf":
-            return GTVFSolidScheme(["plate"], 2, RHO0, E, POISSON, **common)
+            fixed = ("wall",) if o.clamp == "wall" else ()
+            return GTVFSolidScheme(["plate"], 2, RHO0, E, POISSON, fixed=fixed, **common)
         corrections = () if o.no_corrections else SOLID_CORRECTIONS
         return CTVFSolidScheme(["plate"], 2, RHO0, E, POISSON, corrections=corrections,
                                edac_damping=o.edac_damping, **common)
@@ -178,7 +233,8 @@ class OscillatingPlate(Application):
         return {"dx": self.dx, "scheme": o.scheme, "shifting": self.shifting, "vf": o.vf, "length": o.length,
                 "height": o.height, "nh": o.nh, "c0": self.c0, "free_surface": self.free_surface,
                 "corrections": not o.no_corrections, "sparse_initial": self.sparse0,
-                "surface_pressure": o.surface_pressure, "edac_damping": o.edac_damping}
+                "surface_pressure": o.surface_pressure, "edac_damping": o.edac_damping, "kernel": o.kernel,
+                "hdx": o.hdx, "p_ref": self.p_ref, "clamp": o.clamp, "clamp_layers": o.clamp_layers}
 
     # ------------------------------------------------------------ samples
     def separation(self, pa):

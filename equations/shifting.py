@@ -101,27 +101,67 @@ def quintic_dwdr(r=0.0, h=1.0, fac=1.0, dim=2):
     return -5.0 * s * val * hi
 
 
+@helper
+def wendland_dwdr(r=0.0, h=1.0, fac=1.0, dim=2):
+    """dW/dr of the Wendland C2 kernel at any smoothing length h (``fac`` its a_d), as
+    :func:`quintic_dwdr` for the reduced-h gradient of the GTVF (Wendland 1995)."""
+    hi = 1.0 / h
+    q = r * hi
+    val = 0.0
+    if q < 2.0:
+        t = 1.0 - 0.5 * q
+        val = -5.0 * q * t * t * t
+    s = fac * hi
+    if dim > 1:
+        s = s * hi
+    if dim > 2:
+        s = s * hi
+    return s * val * hi
+
+
+REDUCED_KERNELS = {"QuinticSpline": 0, "WendlandQuinticC2": 1}
+"""Kernels whose gradient GTVFHomogenisation can take at a reduced h (``kernel`` switch)."""
+
+
+class BodyPressureMax(Equation):
+    """p_max = max_b |p_b| over the destination body, after the group (a reduction): the
+    cap of the GTVF homogenisation's p0 with ``body_cap`` (:class:`GTVFHomogenisation`)."""
+
+    def __init__(self, dest, sources=None):
+        super().__init__(dest, None)
+
+    def reduce(self, dst, t, dt):
+        dst.p_max[0] = float(np.abs(dst.p).max()) if dst.n else 0.0
+
+
 class GTVFHomogenisation(Equation):
     """(du/dt)_c = -p0_a sum_b m_b / rho_a^2 grad W(r_ab, hfac h_ab), p0_a = min(10 |p_a|, p_ref)
     (Zhang, Hu & Adams 2017, eqs. 22-23 with the sign of their eq. 25 moved in; hfac = 0.5).
 
-    ``fac`` is the quintic spline's normalisation for ``dim`` (``QuinticSpline(dim).fac``);
-    ``hfac`` = 1 uses the scene kernel's DWIJ directly.
+    ``fac`` is the normalisation of the scene's kernel for ``dim`` (``kernel.fac``),
+    ``kernel`` 0 for the quintic spline, 1 for the Wendland C2 (:data:`REDUCED_KERNELS`);
+    ``hfac`` = 1 uses the scene kernel's DWIJ directly.  ``body_cap`` = 1: p0_a =
+    min(10 |p_a|, p_max), p_max = max_b |p_b| of the body (the constant ``p_max`` that
+    :class:`BodyPressureMax` sets every evaluation) instead of the fixed ``p_ref``.
     """
 
     positive = ("p_ref", "hfac", "fac")
-    switches = ("dim", "hfac")
+    switches = ("dim", "hfac", "kernel", "body_cap")
 
-    def __init__(self, dest, sources, p_ref=1.0, hfac=0.5, fac=1.0, dim=2):
-        super().__init__(dest, sources, p_ref=p_ref, hfac=hfac, fac=fac, dim=int(dim))
+    def __init__(self, dest, sources, p_ref=1.0, hfac=0.5, fac=1.0, dim=2, kernel=0, body_cap=0):
+        super().__init__(dest, sources, p_ref=p_ref, hfac=hfac, fac=fac, dim=int(dim), kernel=int(kernel),
+                         body_cap=int(body_cap))
 
     def initialize(self, d_idx, d_auhat, d_avhat, d_awhat):
         d_auhat[d_idx] = 0.0
         d_avhat[d_idx] = 0.0
         d_awhat[d_idx] = 0.0
 
-    def loop(self, d_idx, d_auhat, d_avhat, d_awhat, d_p, d_rho, s_idx, s_m, XIJ, RIJ, HIJ, DWIJ):
-        p0 = min(10.0 * fabs(d_p[d_idx]), self.p_ref)
+    def loop(self, d_idx, d_auhat, d_avhat, d_awhat, d_p, d_rho, d_p_max, s_idx, s_m, XIJ, RIJ, HIJ, DWIJ):
+        cap = self.p_ref
+        if self.body_cap == 1:
+            cap = d_p_max[0]
+        p0 = min(10.0 * fabs(d_p[d_idx]), cap)
         ra = 1.0 / d_rho[d_idx]
         f = -p0 * s_m[s_idx] * ra * ra
         if self.hfac == 1.0:
@@ -129,7 +169,12 @@ class GTVFHomogenisation(Equation):
             d_avhat[d_idx] += f * DWIJ[1]
             d_awhat[d_idx] += f * DWIJ[2]
         elif RIJ > 1e-12:
-            g = f * quintic_dwdr(RIJ, self.hfac * HIJ, self.fac, self.dim) / RIJ
+            dwdr = 0.0
+            if self.kernel == 1:
+                dwdr = wendland_dwdr(RIJ, self.hfac * HIJ, self.fac, self.dim)
+            else:
+                dwdr = quintic_dwdr(RIJ, self.hfac * HIJ, self.fac, self.dim)
+            g = f * dwdr / RIJ
             d_auhat[d_idx] += g * XIJ[0]
             d_avhat[d_idx] += g * XIJ[1]
             d_awhat[d_idx] += g * XIJ[2]
@@ -292,7 +337,8 @@ class Shifting:
 
     ``kind`` in :data:`SHIFTINGS`.  Parameters: ``dim``, ``h``, ``dx``, ``c0``, ``umax``,
     ``kernel`` (a :mod:`sphgen.kernels` instance), ``mach`` (SPST, default umax/c0),
-    ``pb`` (TVF background pressure), ``p_ref`` (GTVF, default rho0 c0^2),
+    ``pb`` (TVF background pressure), ``p_ref`` (GTVF, default rho0 c0^2; 'body': the
+    body's largest |p| each step, :meth:`pressure_equations`),
     ``ipst_tolerance``, ``ipst_max_iterations``, ``ipst_interval`` (IPST every k steps),
     ``chi_ref`` (IPST reference, default the lattice value of ``dx``).
     """
@@ -302,8 +348,11 @@ class Shifting:
                  chi_ref=None, gtvf_hfac=0.5):
         if kind not in SHIFTINGS:
             raise ValueError(f"shifting must be one of {', '.join(SHIFTINGS)}; got {kind!r}")
-        if kind == "gtvf" and type(kernel).__name__ != "QuinticSpline" and gtvf_hfac != 1.0:
-            raise ValueError("gtvf shifting at a reduced h is implemented for the quintic spline only")
+        if kind == "gtvf" and type(kernel).__name__ not in REDUCED_KERNELS and gtvf_hfac != 1.0:
+            raise ValueError("gtvf shifting at a reduced h is implemented for the quintic spline and the "
+                             "Wendland C2 only")
+        if isinstance(p_ref, str) and p_ref != "body":
+            raise ValueError(f"p_ref must be a pressure or 'body' (the body's largest |p|), got {p_ref!r}")
         if not (isinstance(ipst_interval, int) and ipst_interval >= 1):
             raise ValueError(f"ipst_interval must be an integer >= 1, got {ipst_interval!r}")
         if not (isinstance(ipst_max_iterations, int) and ipst_max_iterations >= 1):
@@ -313,6 +362,7 @@ class Shifting:
         self.mach = umax / c0 if mach is None else mach
         self.pb = 2.0 * rho0 * c0 * c0 if pb is None else pb
         self.p_ref = rho0 * c0 * c0 if p_ref is None else p_ref
+        self.body_cap = self.p_ref == "body"
         self.ipst_tolerance, self.ipst_max_iterations = ipst_tolerance, ipst_max_iterations
         self.ipst_interval, self.gtvf_hfac = ipst_interval, gtvf_hfac
         self.chi_ref = lattice_chi(kernel, dx, h, dim) if (kind == "ipst" and chi_ref is None) else chi_ref
@@ -341,6 +391,8 @@ class Shifting:
         for p in ("uhat", "vhat", "what", "auhat", "avhat", "awhat"):
             if not pa.has(p):
                 pa.add_property(p)
+        if self.kind == "gtvf" and self.body_cap and not pa.has("p_max"):
+            pa.add_constant("p_max", 0.0)
         if self.kind == "ipst":
             for p in ("ipst_x0", "ipst_y0", "ipst_z0", "ipst_sx", "ipst_sy", "ipst_sz",
                       "ipst_dx", "ipst_dy", "ipst_dz", "ipst_chi"):
@@ -357,10 +409,19 @@ class Shifting:
         if self.kind == "tvf":
             return [BackgroundPressureAcceleration(dest, sources, pb=self.pb)]
         if self.kind == "gtvf":
-            return [GTVFHomogenisation(dest, sources, p_ref=self.p_ref, hfac=self.gtvf_hfac,
-                                       fac=getattr(self.kernel, "fac", 1.0), dim=self.dim)]
+            return [GTVFHomogenisation(dest, sources, p_ref=1.0 if self.body_cap else self.p_ref,
+                                       hfac=self.gtvf_hfac, fac=getattr(self.kernel, "fac", 1.0), dim=self.dim,
+                                       kernel=REDUCED_KERNELS.get(type(self.kernel).__name__, 0),
+                                       body_cap=self.body_cap)]
         if self.kind == "ipst" and self.ipst_interval > 1:
             return [ZeroHomogenisation(dest)]
+        return []
+
+    def pressure_equations(self, dest):
+        """Equations to run with the equation of state (after it, in its group): the body's
+        largest |p|, the cap of the GTVF p0 when ``p_ref`` is 'body'; [] otherwise."""
+        if self.kind == "gtvf" and self.body_cap:
+            return [BodyPressureMax(dest)]
         return []
 
     def _ipst_due(self, t, dt):

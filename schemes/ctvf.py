@@ -175,6 +175,9 @@ class TransportVelocityScheme(Scheme):
         self.shift = Shifting(shifting, self.dim, h, dx, c0, umax, self.kernel, rho0=rho0, mach=mach,
                               pb=pb, p_ref=p_ref, ipst_tolerance=ipst_tolerance,
                               ipst_max_iterations=ipst_max_iterations, ipst_interval=ipst_interval)
+        if self.shift.body_cap and not callable(getattr(self, "_eos_group", None)):
+            raise ValueError(f"{type(self).__name__}: p_ref='body' needs the body's largest |p| after the "
+                             "equation of state, which only the GTVF schemes compute")
         if surface_pressure and not free_surface:
             raise ValueError("surface_pressure needs free_surface=True")
         self.free_surface, self.surface_pressure = bool(free_surface), bool(surface_pressure)
@@ -426,6 +429,7 @@ class ElasticSolids:
 
     transport_gradient = False
     output_props = ("x", "y", "z", "u", "v", "w", "p", "rho", "m", "h", "sd")
+    fixed = ()
 
     def _init_solid(self, G, clamped, jaumann_correction, yield_stress=None, contact=False, driven=None):
         if self.walls:
@@ -472,10 +476,10 @@ class ElasticSolids:
         return [(d, s) for d in self.fluids for s in self.fluids if self.contact and d != s]
 
     def _sources(self, dest):
-        """With ``contact`` a body sees only itself (and the walls)."""
+        """With ``contact`` a body sees only itself (and the walls); the ``fixed`` arrays too."""
         if self.contact:
-            return [dest] + self.walls
-        return super()._sources(dest)
+            return [dest] + self.walls + list(self.fixed)
+        return super()._sources(dest) + list(self.fixed)
 
     def setup_properties(self, arrays):
         super().setup_properties(arrays)
@@ -484,6 +488,10 @@ class ElasticSolids:
                 for p in ("sd", "asd", "gradv"):
                     if not pa.has(p):
                         pa.add_property(p, stride=9)
+            if pa.name in self.fixed:      # at rest, unstressed: u = u~ = 0, p = 0, sd = 0
+                for p in ("u", "v", "w", "uhat", "vhat", "what", "p", "sd"):
+                    if p not in pa.data:
+                        pa.add_property(p, stride=9 if p == "sd" else 1, default=0.0)
 
     def _stress_rate_groups(self):
         """Eq. 31, then eq. 32 (rate and transport correction): evaluation 0."""

@@ -72,8 +72,13 @@ class GTVFScheme(TransportVelocityScheme):
                        Group([CorrectedSummationDensity(d, self._sources(d)) for d in self.fluids])]
         else:
             groups.append(Group([SummationDensity(d, self._sources(d)) for d in self.fluids]))
-        groups.append(Group([TaitEOS(d, rho0=self.rho0, c0=self.c0, gamma=1.0) for d in self.fluids]))
+        groups.append(self._eos_group())
         return groups
+
+    def _eos_group(self):
+        """p = c0^2 (rho - rho0), then (p_ref 'body') the body's largest |p|, the cap of p0."""
+        eqs = [TaitEOS(d, rho0=self.rho0, c0=self.c0, gamma=1.0) for d in self.fluids]
+        return Group(eqs + [e for d in self.fluids for e in self.shift.pressure_equations(d)])
 
     def _momentum_group(self):
         """Zhang et al. eq. 17: pressure gradient, transport stress, viscosity, (du/dt)_c."""
@@ -103,18 +108,24 @@ class GTVFSolidScheme(ElasticSolids, GTVFScheme):
     (default off: the original GTVF has no surface detection) adds the surface treatment
     of the CTVF (sections 3.4-3.5) to the shifting.  Density by continuity with u~ (no
     summation re-initialisation: a solid with free surfaces), p = c0^2 (rho - rho0).
-    ``contact``: separate bodies touching without tension, as the CTVF solid."""
+    ``contact``: separate bodies touching without tension, as the CTVF solid.
+    ``fixed``: names of arrays of particles at rest and unstressed (u = u~ = 0, p = 0,
+    deviatoric stress 0, rho = rho0 as given), neighbours of the solids in every sum and
+    never updated: a clamp of fixed wall particles around a body."""
 
     transport_gradient = True
 
     def __init__(self, solids, dim, rho0, E, poisson, h, dx, umax=1.0, shifting="gtvf", alpha=1.0,
-                 clamped=None, yield_stress=None, contact=False, driven=None, **kw):
+                 clamped=None, yield_stress=None, contact=False, driven=None, fixed=(), **kw):
         c0, G = elastic_constants(E, poisson, rho0)
         self.E, self.poisson = E, poisson
         super().__init__(solids, dim, rho0, c0, 0.0, h, dx, umax=umax, shifting=shifting,
                          density="continuity", alpha=alpha, **kw)
         self._init_solid(G, clamped or {}, False, yield_stress, contact, driven)
+        self.fixed = tuple(fixed)
+        if set(self.fixed) & set(self.fluids):
+            raise ValueError(f"{type(self).__name__}: fixed arrays {self.fixed} must not be among the solids")
 
     def _density_groups(self):
         """p = c0^2 (rho - rho0), rho from the continuity equation."""
-        return [Group([TaitEOS(d, rho0=self.rho0, c0=self.c0, gamma=1.0) for d in self.fluids])]
+        return [self._eos_group()]

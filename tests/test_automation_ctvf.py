@@ -114,6 +114,8 @@ def test_solid_problems_define_their_runs_and_figures(tmp_path):
     assert [p["vf"] for p in cs.table1_cases(paper["table1"]).values()] == [0.001, 0.01, 0.03, 0.05]
     plate = cs.plate_cases(paper["plate"])
     assert plate["gtvf_spst"]["shifting"] == "spst" and "free_surface" in plate["gtvf_spst"]
+    assert all(plate[n]["kernel"] == "wendland" and plate[n]["hdx"] == 1.3 for n in ("gtvf", "gtvf_spst"))
+    assert "kernel" not in plate["ctvf_spst"]
     assert plate["ctvf_spst_h001"]["height"] == 0.01 and plate["ctvf_spst_h001"]["separation_time"] == 0.51
     assert [p["nh"] for p in cs.fig21_cases(paper["fig21"]).values()] == [10, 20, 30]
     assert {p["shifting"] for p in cs.ring_cases(paper["rings"]).values()} == {"spst", "ipst"}

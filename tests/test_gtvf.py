@@ -8,8 +8,8 @@ from sphgen.app import load_application
 from sphgen.equation import Equation, Group
 from sphgen.equations.basic import SummationDensity
 from sphgen.equations.density import CorrectedSummationDensity, SaveDensity
-from sphgen.equations.shifting import GTVFHomogenisation, quintic_dwdr
-from sphgen.kernels import QuinticSpline
+from sphgen.equations.shifting import BodyPressureMax, GTVFHomogenisation, quintic_dwdr, wendland_dwdr
+from sphgen.kernels import QuinticSpline, WendlandQuinticC2
 from sphgen.particles import ParticleArray
 from sphgen.scene import Scene
 from sphgen.schemes.gtvf import GTVFScheme
@@ -60,6 +60,37 @@ def test_quintic_helper_matches_the_kernel():
         for h in (0.05, 0.1, 0.37):
             for q in (0.0, 0.3, 0.99, 1.0, 1.5, 2.2, 2.999, 3.5):
                 assert quintic_dwdr(q * h, h, k.fac, dim) == pytest.approx(k.dwdr(q * h, h), rel=1e-13, abs=1e-300)
+
+
+def test_wendland_helper_matches_the_kernel():
+    for dim in (1, 2, 3):
+        k = WendlandQuinticC2(dim)
+        for h in (0.05, 0.1, 0.37):
+            for q in (0.0, 0.3, 0.99, 1.0, 1.5, 1.999, 2.0, 2.5):
+                assert wendland_dwdr(q * h, h, k.fac, dim) == pytest.approx(k.dwdr(q * h, h), rel=1e-13, abs=1e-300)
+
+
+def test_body_cap_is_the_largest_pressure():
+    """p_ref 'body': BodyPressureMax sets p_max = max|p| after its group, and the
+    homogenisation with body_cap equals the one with the fixed p_ref = max|p| (both kernels)."""
+    for kernel, code in ((QuinticSpline(2), 0), (WendlandQuinticC2(2), 1)):
+        res = []
+        for body_cap in (1, 0):
+            pa = lattice_cloud(nx=10, jitter=0.3, seed=2)
+            pa.add_property("p", data=np.linspace(-3.0, 2.0, pa.n))
+            pa.add_constant("p_max", 0.0)
+            for p in ("auhat", "avhat", "awhat"):
+                pa.add_property(p)
+            eq = GTVFHomogenisation("fluid", ["fluid"], p_ref=1.0 if body_cap else 3.0, hfac=0.5,
+                                    fac=kernel.fac, dim=2, kernel=code, body_cap=body_cap)
+            sc = Scene([pa], [Group([BodyPressureMax("fluid")]), Group([eq])], dim=2, kernel=kernel,
+                       domain=periodic_box(2), outputs={"fluid": ["auhat", "avhat"]})
+            sc.compute(0, 0.0, 1e-3)
+            res.append(np.array([pa.auhat.copy(), pa.avhat.copy()]))
+            if body_cap:
+                assert pa.p_max[0] == 3.0
+        assert np.abs(res[0]).max() > 0
+        assert_close(res[0], res[1], 1e-14, what=type(kernel).__name__)
 
 
 class ZeroAuhat(Equation):
