@@ -49,6 +49,8 @@ E, POISSON, RHO0 = 2.0e6, 0.3975, 1000.0
 KL = 1.875
 PERIOD_PAPER = {0.001: 0.284, 0.01: 0.283, 0.03: 0.283, 0.05: 0.284}
 """T_CTVF of Adepu & Ramachandran (2021), Table 1 (L = 0.2, H = 0.02)."""
+PERIOD_PAPER_GTVF = {0.001: 0.284, 0.01: 0.283, 0.03: 0.284, 0.05: 0.285}
+"""T_GTVF of the same Table 1."""
 SCHEMES = ("ctvf", "gtvf")
 BOND = 1.5            # bond / piece radius, in dx
 NEIGHBOUR_RADIUS = 2.5
@@ -269,7 +271,8 @@ class OscillatingPlate(Application):
         t, y_tip, npieces, stretch, gap, sparse, ke = rows.T
         period, how = measured_period(t, y_tip)
         vf, length, height = hist["vf"], hist["length"], hist["height"]
-        paper = PERIOD_PAPER.get(vf) if abs(length - 0.2) < 1e-12 and abs(height - 0.02) < 1e-12 else None
+        table = PERIOD_PAPER_GTVF if hist["scheme"] == "gtvf" else PERIOD_PAPER
+        paper = table.get(vf) if abs(length - 0.2) < 1e-12 and abs(height - 0.02) < 1e-12 else None
         upto = t <= self.options.separation_time + 1e-9
         sep = dict(pieces_max=int(npieces.max()), bond_stretch_max=float(stretch.max()),
                    bond_gap_max=float(gap.max()), sparse_max=int(sparse.max()))

@@ -111,7 +111,10 @@ def test_solid_problems_define_their_runs_and_figures(tmp_path):
         assert figs and callable(draw)
     assert len(names) == 12 and "ctvf_figs24-28_rings_quick" in names
     paper = cs.PRESETS["paper"]
-    assert [p["vf"] for p in cs.table1_cases(paper["table1"]).values()] == [0.001, 0.01, 0.03, 0.05]
+    table1 = cs.table1_cases(paper["table1"])
+    assert [p["vf"] for p in table1.values()] == [0.001, 0.01, 0.03, 0.05] * 2
+    assert [p.get("scheme", "ctvf") for p in table1.values()] == ["ctvf"] * 4 + ["gtvf"] * 4
+    assert all(p["kernel"] == "wendland" and p["hdx"] == 1.3 for n, p in table1.items() if n.startswith("gtvf"))
     plate = cs.plate_cases(paper["plate"])
     assert plate["gtvf_spst"]["shifting"] == "spst" and "free_surface" in plate["gtvf_spst"]
     assert all(plate[n]["kernel"] == "wendland" and plate[n]["hdx"] == 1.3 for n in ("gtvf", "gtvf_spst"))
@@ -188,7 +191,7 @@ def test_solid_figures_draw_stopped_runs_labelled(tmp_path, section, figure_text
     for name, r in summary.items():
         stop = 0.6 * cases(cfg)[name]["tf"]
         assert r["stopped_at"] == pytest.approx(stop) and r["t"] is None
-        assert all(v is None for k, v in r.items() if k not in ("stopped_at", "vf", "period_paper"))
+        assert all(v is None for k, v in r.items() if k not in ("stopped_at", "scheme", "vf", "period_paper"))
     texts = " || ".join(figure_texts.values())
     assert texts.count("(stopped at t = ") >= len(summary)
     if arrays:      # particle panels only at the times before the stop (0.6 tf)
