@@ -545,3 +545,23 @@ def test_largest_motion_matches_numpy_in_every_lane_and_catches_non_finite(dim):
         for bad in (np.nan, np.inf):
             x[0][n - 1] = bad
             assert all(np.isnan(v) for v in largest_motion(x, ref, h, h_ref, [0.0] * dim))
+
+
+def test_cut_of_many_lists_with_thread_parts_is_repeatable():
+    """All lists cut in one call by thread parts cut anywhere (40 layouts, from one row in
+    the first part to one in the last): every cut equals the fresh build."""
+    rng = np.random.default_rng(5)
+    n = 4000
+    arrays = [make_array(nm, n, 2, rng, h=0.012, hvar=0.2) for nm in ("f", "w")]
+    nn = NeighbourSearch(arrays, 2, 2.0, sort=False, skin=0.2)
+    fresh = NeighbourSearch([ParticleArray(pa.name, **{k: pa.get(k).copy() for k in AXES + ("h", "id")})
+                             for pa in arrays], 2, 2.0, sort=False)
+    keys = (("f", "f"), ("f", "w"), ("w", "f"))
+    expected = {k: fresh.neighbours(*k) for k in keys}
+    for trial in range(40):
+        cut = 1 + trial * (n - 2) // 40
+        parts = {"f": np.array([0, cut, n]), "w": np.array([0, n - cut, n])}
+        nn._row_cache, nn._points = {}, {}
+        for key, (starts, ends, nbrs, pairs) in zip(keys, nn.rows_of(keys, parts)):
+            assert_same_lists(packed(starts, ends, nbrs), expected[key])
+            assert pairs == int(expected[key][0][-1])

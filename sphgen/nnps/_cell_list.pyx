@@ -1002,15 +1002,13 @@ ctypedef struct GatherJob:
     const long* parts
 
 
-cdef inline void _part(const long* parts, Py_ssize_t n, int k, int nt, Py_ssize_t* lo,
-                       Py_ssize_t* hi) noexcept nogil:
-    """Thread k's items of n: ``parts`` (cut by the generated module) or equal counts."""
+cdef inline Py_ssize_t _cut(const long* parts, Py_ssize_t n, int k, int nt) noexcept nogil:
+    """Where thread k's items of n start (k = nt: n): ``parts`` (cut by the generated
+    module) or equal counts.  Assigned to a loop variable, never written through a
+    pointer: a prange makes private only what its body assigns."""
     if parts != NULL:
-        lo[0] = parts[k]
-        hi[0] = parts[k + 1]
-    else:
-        lo[0] = n * k // nt
-        hi[0] = n * (k + 1) // nt
+        return parts[k]
+    return n * k // nt
 
 
 cdef Py_ssize_t _cut_part(const Grid* g, bint open_box, CutJob* job, Py_ssize_t lo, Py_ssize_t hi,
@@ -1098,12 +1096,14 @@ def cut_rows(GridSpec grid, list jobs, list gathers, double radius_scale):
         if ng:
             for k in prange(nt, nogil=True, schedule="static", num_threads=nt):
                 for j in range(ng):
-                    _part(gj[j].parts, gj[j].n, k, nt, &lo, &hi)
+                    lo = _cut(gj[j].parts, gj[j].n, k, nt)
+                    hi = _cut(gj[j].parts, gj[j].n, k + 1, nt)
                     for i in range(lo, hi):
                         _record(gj[j].out, gj[j].x, gj[j].h, i, radius_scale)
         for k in prange(nt, nogil=True, schedule="static", num_threads=nt):
             for j in range(nj):
-                _part(cj[j].parts, cj[j].nd, k, nt, &lo, &hi)
+                lo = _cut(cj[j].parts, cj[j].nd, k, nt)
+                hi = _cut(cj[j].parts, cj[j].nd, k + 1, nt)
                 found[j * nt + k] = _cut_part(g, open_box, &cj[j], lo, hi, radius_scale)
         return [sum(found[j * nt + k] for k in range(nt)) for j in range(nj)]
     finally:
