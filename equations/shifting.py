@@ -77,6 +77,17 @@ class BackgroundPressureAcceleration(Equation):
 
 # ----------------------------------------------------------------------------- GTVF
 @helper
+def kernel_norm(fac=1.0, hi=1.0, dim=2):
+    """A kernel's normalisation a_d / h^d from a_d (``fac``) and 1/h (``hi``)."""
+    s = fac * hi
+    if dim > 1:
+        s = s * hi
+    if dim > 2:
+        s = s * hi
+    return s
+
+
+@helper
 def quintic_dwdr(r=0.0, h=1.0, fac=1.0, dim=2):
     """dW/dr of the quintic spline at any smoothing length h (``fac`` is its normalisation
     sigma_d).  The scene's kernel is callable only at h_ab (the DWIJ symbol); this helper
@@ -93,12 +104,7 @@ def quintic_dwdr(r=0.0, h=1.0, fac=1.0, dim=2):
         val = a * a * a * a - 6.0 * b * b * b * b
     elif q < 3.0:
         val = a * a * a * a
-    s = fac * hi
-    if dim > 1:
-        s = s * hi
-    if dim > 2:
-        s = s * hi
-    return -5.0 * s * val * hi
+    return -5.0 * kernel_norm(fac, hi, dim) * val * hi
 
 
 @helper
@@ -111,12 +117,7 @@ def wendland_dwdr(r=0.0, h=1.0, fac=1.0, dim=2):
     if q < 2.0:
         t = 1.0 - 0.5 * q
         val = -5.0 * q * t * t * t
-    s = fac * hi
-    if dim > 1:
-        s = s * hi
-    if dim > 2:
-        s = s * hi
-    return s * val * hi
+    return kernel_norm(fac, hi, dim) * val * hi
 
 
 REDUCED_KERNELS = {"QuinticSpline": 0, "WendlandQuinticC2": 1}

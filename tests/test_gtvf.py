@@ -54,20 +54,15 @@ def test_gtvf_compiled_matches_python(kw):
     assert np.abs(a.auhat).max() > 0 and np.abs(a.au).max() > 0
 
 
-def test_quintic_helper_matches_the_kernel():
+@pytest.mark.parametrize("kernel, dwdr, qs", [
+    (QuinticSpline, quintic_dwdr, (0.0, 0.3, 0.99, 1.0, 1.5, 2.2, 2.999, 3.5)),
+    (WendlandQuinticC2, wendland_dwdr, (0.0, 0.3, 0.99, 1.0, 1.5, 1.999, 2.0, 2.5))])
+def test_reduced_h_helpers_match_the_kernels(kernel, dwdr, qs):
     for dim in (1, 2, 3):
-        k = QuinticSpline(dim)
+        k = kernel(dim)
         for h in (0.05, 0.1, 0.37):
-            for q in (0.0, 0.3, 0.99, 1.0, 1.5, 2.2, 2.999, 3.5):
-                assert quintic_dwdr(q * h, h, k.fac, dim) == pytest.approx(k.dwdr(q * h, h), rel=1e-13, abs=1e-300)
-
-
-def test_wendland_helper_matches_the_kernel():
-    for dim in (1, 2, 3):
-        k = WendlandQuinticC2(dim)
-        for h in (0.05, 0.1, 0.37):
-            for q in (0.0, 0.3, 0.99, 1.0, 1.5, 1.999, 2.0, 2.5):
-                assert wendland_dwdr(q * h, h, k.fac, dim) == pytest.approx(k.dwdr(q * h, h), rel=1e-13, abs=1e-300)
+            for q in qs:
+                assert dwdr(q * h, h, k.fac, dim) == pytest.approx(k.dwdr(q * h, h), rel=1e-13, abs=1e-300)
 
 
 def test_body_cap_is_the_largest_pressure():
