@@ -492,6 +492,70 @@ def test_skin_gives_the_exact_lists_and_rebuilds_only_when_needed(dim, periodic,
     assert fresh.n_builds == fresh.n_updates + 1
 
 
+@pytest.mark.parametrize("periodic", [False, True])
+def test_an_update_checks_the_skin_and_cuts_the_rows_in_one_call(periodic, monkeypatch):
+    """Once an update's lists have been cut, each following update (while the skin lists
+    stand) checks the skin and cuts the same lists in one compiled call, no separate skin
+    check; the rows equal a fresh build through motion, a rebuild, a replaced coordinate
+    array (the plan is dropped, never used on stale memory), and a non-finite position is
+    still named by the rebuild."""
+    import sphgen.nnps as nnps_mod
+    calls = {"cut": 0, "motion": 0}
+    real_cut, real_motion = nnps_mod.cut_rows, nnps_mod.largest_motion
+
+    def cut(*args, **kw):
+        calls["cut"] += 1
+        return real_cut(*args, **kw)
+
+    def motion(*args, **kw):
+        calls["motion"] += 1
+        return real_motion(*args, **kw)
+    monkeypatch.setattr(nnps_mod, "cut_rows", cut)
+    monkeypatch.setattr(nnps_mod, "largest_motion", motion)
+    rng = np.random.default_rng(31)
+    dim, h = 2, 0.04
+    dom = domain_for((periodic,) * dim)
+    skinned = [make_array(nm, 400, dim, rng, h=h, hvar=0.2) for nm in ("f", "w")]
+    exact = [ParticleArray(pa.name, **{k: pa.get(k).copy() for k in AXES + ("h", "id")}) for pa in skinned]
+    nn = NeighbourSearch(skinned, dim, 2.0, dom, sort=False, skin=0.2)
+    fresh = NeighbourSearch(exact, dim, 2.0, dom, sort=False)
+    keys = (("f", "f"), ("f", "w"), ("w", "f"))
+    parts = {"f": np.array([0, 150, 400]), "w": np.array([0, 300, 400])}
+
+    def check():
+        fresh.update()
+        for (d, s), (starts, ends, nbrs, pairs) in zip(keys, nn.rows_of(keys, parts)):
+            assert_same_lists(packed(starts, ends, nbrs), fresh.neighbours(d, s))
+            assert pairs == fresh.pair_totals()[(d, s)]
+    nn.update()
+    check()                                  # cut the usual way: the plan is made
+    builds, planned = nn.n_builds, 0
+    for step in range(12):
+        for group in (skinned, exact):
+            _drift(group[0], dim, step, 2e-5)
+        calls.update(cut=0, motion=0)
+        nn.update()
+        assert nn.n_builds == builds and calls == {"cut": 1, "motion": 0}
+        check()
+        assert calls["cut"] == 1             # nothing left to cut
+        planned += 1
+    assert planned == 12
+    for group in (skinned, exact):           # beyond the skin: a rebuild, then the usual cut
+        group[0].get("x")[3] += nn.skin_distance
+    nn.update()
+    assert nn.n_builds == builds + 1
+    check()
+    for pa in (skinned[0], exact[0]):        # new memory for x: the plan is not used on the old
+        pa.data["x"] = pa.get("x") + 0.15 * nn.skin_distance
+    calls.update(cut=0, motion=0)
+    nn.update()
+    assert calls["motion"] >= 1
+    check()
+    skinned[1].get("y")[7] = np.nan
+    with pytest.raises(ValueError, match="'w'.*y|y.*'w'"):
+        nn.update()
+
+
 def test_skin_rebuilds_at_once_for_a_large_jump_or_a_new_particle_count():
     rng = np.random.default_rng(9)
     pa = make_array("f", 300, 2, rng, h=0.03)

@@ -79,6 +79,11 @@ class Domain:
         return f"Domain({box})"
 
 
+def _same_parts(a, b):
+    """Whether two {array: thread parts} maps hold the very same arrays."""
+    return a.keys() == b.keys() and all(a[k] is b[k] for k in a)
+
+
 def _morton_rank(n, dim):
     """int32 array: storage rank of each linear cell ``ix + nx*(iy + ny*iz)``, so
     that cells sorted by rank follow the Morton (Z-order) curve."""
@@ -178,6 +183,7 @@ class NeighbourSearch:
         self._cache = {}
         self._row_cache = {}     # (dest, src) -> (starts, ends, nbrs, pairs) since the update
         self._row_buffers = {}   # (dest, src) -> buffers of the cut rows, kept across updates
+        self._plan = None        # the cut of every update while the skin lists stand
         self._frozen = {}
         self._rows = {}          # (dest, src) -> RowBuffers kept across updates
         self._bins = {}
@@ -216,30 +222,61 @@ class NeighbourSearch:
         rebuild the cell lists (unless a skin still covers the motion since the last
         rebuild) and drop the cached neighbour lists."""
         self.n_updates += 1
-        if self._built_at is not None and self._within_skin():
-            self._cache = {}
-            self._row_cache = {}
-            self._points = {}
-            return
+        if self._built_at is not None:
+            kept = self._refresh()
+            if kept is None:          # no refresh planned: the skin check alone
+                kept = self._within_skin()
+                if kept:
+                    self._row_cache = {}
+                    self._points = {}
+            if kept:
+                self._cache = {}
+                return
         self._build()
+
+    def _refresh(self):
+        """The update of the rows cut at the previous update (:meth:`_plan_refresh`), skin
+        check included, in one compiled call: True if they are cut anew, False if the
+        lists must be rebuilt, None if there is no such plan (or an array's memory or size
+        changed since it was made)."""
+        plan = self._plan
+        if plan is None:
+            return None
+        for pa, n, arrays in plan["arrays"]:
+            if pa.n != n or any(pa.get(p) is not v for p, v in arrays):
+                self._plan = None
+                return None
+        if not self._wrap():
+            return False
+        pairs = cut_rows(self.grid, plan["jobs"], plan["gathers"], self.radius_scale, plan["motions"],
+                         self.skin_distance, self._periodic_lengths)
+        if pairs is None:
+            return False
+        self._points = dict(plan["records"])
+        self._row_cache = {key: (kept[1], kept[3], kept[4], int(n)) for (key, kept), n in zip(plan["kept"], pairs)}
+        return True
+
+    def _wrap(self):
+        """Wrap positions into the periodic box (periodic axes only); False if one is not
+        finite (the rebuild names it)."""
+        dom = self.domain
+        for pa in self.arrays:
+            for a in range(self.dim):
+                if dom.periodic[a] and pa.n and wrap_periodic(pa.get(_AXES[a]), dom.lo[a], dom.length[a]) >= 0:
+                    return False
+        return True
 
     def _within_skin(self):
         """Wrap positions; True if no pair can have come within reach since the rebuild."""
-        dom, dim = self.domain, self.dim
+        if any(pa.n != self._sizes[pa.name] for pa in self.arrays) or not self._wrap():
+            return False                      # non-finite: the rebuild names it
         moved2, dh = 0.0, 0.0
-        lengths = self._periodic_lengths
         for pa in self.arrays:
-            if pa.n != self._sizes[pa.name]:
-                return False
             if not pa.n:
                 continue
             ref = self._built_at[pa.name]
-            coords = [pa.get(_AXES[a]) for a in range(dim)]
-            for a in range(dim):
-                if dom.periodic[a] and wrap_periodic(coords[a], dom.lo[a], dom.length[a]) >= 0:
-                    return False              # non-finite: the rebuild names it
             try:
-                m2, mh = largest_motion(coords, ref[:-1], pa.get("h"), ref[-1], lengths)
+                m2, mh = largest_motion(self._coords(pa), ref[:-1], pa.get("h"), ref[-1], self._periodic_lengths)
             except (TypeError, ValueError):   # replaced by a wrong array: the rebuild names it
                 return False
             if not (math.isfinite(m2) and math.isfinite(mh)):
@@ -299,6 +336,7 @@ class NeighbourSearch:
         self._row_cache = {}
         self._points = {}
         self._skin_lists = {}
+        self._plan = None
         self.n_builds += 1
         if skin > 0:
             self._built_at = {pa.name: [self._checked(pa, _AXES[a]).copy() for a in range(dim)]
@@ -441,8 +479,34 @@ class NeighbourSearch:
                     self._row_cache[(d.name, s.name)] = (off[:-1], off[1:], nbrs, int(off[-1]))
                 cut = [(d, s, self._built_lists(d, s)) for d, s in todo if (d.name, s.name) not in self._cache]
                 if cut:
+                    first = not self._row_cache and not cached
                     self._row_cache.update(self._cut_rows(cut, parts or {}))
+                    if first:         # the lists an update needs: cut them at the next ones
+                        self._plan_refresh(cut, parts or {})
+        elif self._plan is not None and parts is not None and not _same_parts(parts, self._plan["parts"]):
+            self._plan = None         # other thread parts: planned anew at the next cut
         return [self._row_cache[(d.name, s.name)] for d, s in keys]
+
+    def _plan_refresh(self, cut, parts):
+        """Keep what :func:`cut_rows` needs to check the skin and cut the rows of ``cut``
+        ((d, s, lists) triples: the lists of a whole update) at each following update
+        until the rebuild: the calls of one update become one."""
+        self._plan = None
+        if self._built_at is None:
+            return
+        gathers, records = [], {}
+        for d, s, lists in cut:
+            if s.name not in records:
+                records[s.name] = self._points[s.name]
+                gathers.append((self._coords(s), s.get("h"), records[s.name], parts.get(s.name)))
+        kept = [((d.name, s.name), self._row_buffers[(d.name, s.name)]) for d, s, _ in cut]
+        jobs = [(lists[0], lists[1], self._coords(d), d.get("h"), records[s.name], buf[4], buf[2],
+                 parts.get(d.name)) for (d, s, lists), (_, buf) in zip(cut, kept)]
+        motions = [(self._coords(pa), ref[:-1], pa.get("h"), ref[-1], parts.get(pa.name))
+                   for pa in self.arrays for ref in [self._built_at[pa.name]] if pa.n]
+        arrays = [(pa, pa.n, [(p, pa.get(p)) for p in _AXES[:self.dim] + ("h",)]) for pa in self.arrays]
+        self._plan = {"jobs": jobs, "gathers": gathers, "motions": motions, "records": records,
+                      "kept": kept, "arrays": arrays, "parts": parts}
 
     def _cut_rows(self, todo, parts):
         """{(dest, src): rows} cut in place from the skin lists of ``todo`` ((d, s, lists)

@@ -35,7 +35,7 @@ minimum image, computed as ``(x_i - x_j) -/+ L`` like the usual formula); an axi
 with fewer cells visits every cell once and takes the minimum image pair by pair.
 """
 from cython.parallel cimport prange
-from libc.math cimport fabs, floor, isfinite, round
+from libc.math cimport fabs, floor, isfinite, round, sqrt
 from libc.stdlib cimport free, malloc, realloc
 from libc.string cimport memcpy
 
@@ -1002,6 +1002,15 @@ ctypedef struct GatherJob:
     const long* parts
 
 
+ctypedef struct MotionJob:
+    const double* x[3]   # one array's coordinates and h now ...
+    const double* r[3]   # ... and at the build of the skin lists
+    const double* h
+    const double* h_ref
+    Py_ssize_t n
+    const long* parts
+
+
 cdef inline Py_ssize_t _cut(const long* parts, Py_ssize_t n, int k, int nt) noexcept nogil:
     """Where thread k's items of n start (k = nt: n): ``parts`` (cut by the generated
     module) or equal counts.  Assigned to a loop variable, never written through a
@@ -1037,7 +1046,8 @@ cdef const long* _parts_ptr(object parts, Py_ssize_t n, int nt) except? NULL:
     return &v[0]
 
 
-def cut_rows(GridSpec grid, list jobs, list gathers, double radius_scale):
+def cut_rows(GridSpec grid, list jobs, list gathers, double radius_scale, list motions=None,
+             double skin_distance=0.0, lengths=None):
     """The exact lists (``|r_ij| < k max(h_i, h_j)`` now) of several (dest, src) pairs, cut
     from their lists with a skin, as rows in place; returns the number of pairs of each.
 
@@ -1049,23 +1059,52 @@ def cut_rows(GridSpec grid, list jobs, list gathers, double radius_scale):
     a fresh exact build.  ``parts`` (int64, one more than the threads, or None) say which
     particles thread k handles: the generated module's thread parts, so that each row is
     cut, and each record gathered, by the thread that wrote those particles and walks those
-    rows.  Two parallel regions in all (the records, then every list), one Python call."""
+    rows.  Two parallel regions in all (the records, then every list), one Python call.
+
+    ``motions`` (optional): ``(coords, refs, h, h_ref, parts)`` per array of the search,
+    its coordinates and ``h`` now and at the build of the skin lists; each thread then also
+    measures, in the first region, how far its particles moved, and the lists are cut only
+    if no pair can have come within reach since the build (twice the largest displacement
+    plus ``radius_scale`` times the largest change of h at most ``skin_distance``;
+    ``lengths[a] > 0``: axis ``a`` periodic, minimum image).  Returns None, having cut
+    nothing, if some pair can have (or a value is not finite): the lists must be rebuilt.
+    The skin check of an update and its cut are then one call (the skin check alone was
+    a Python loop and a parallel region per array)."""
     cdef const Grid* g = &grid.c
     cdef int nt = max(1, min(sphgen_max_threads(), 64))
     cdef Py_ssize_t nj = len(jobs), ng = len(gathers), j, i, lo, hi, cnt
+    cdef Py_ssize_t nm = 0 if motions is None else len(motions)
     cdef int a, k
-    cdef double kh
+    cdef double kh, m2 = 0.0, mh = 0.0
+    cdef double L[3]
     cdef bint open_box = g.dim >= 2 and not (g.periodic[0] or g.periodic[1] or g.periodic[2])
     cdef CutJob* cj = <CutJob*>malloc((nj + 1) * sizeof(CutJob))
     cdef GatherJob* gj = <GatherJob*>malloc((ng + 1) * sizeof(GatherJob))
+    cdef MotionJob* mj = <MotionJob*>malloc((nm + 1) * sizeof(MotionJob))
     cdef Py_ssize_t* found = <Py_ssize_t*>malloc((nj * nt + 1) * sizeof(Py_ssize_t))
+    # per thread: largest |dx|^2 and |dh| of its parts (8 doubles apart: no shared line)
+    cdef double* moved = <double*>malloc((8 * nt + 2) * sizeof(double))
     cdef int[::1] off, nbrs, out, ends
-    cdef double[::1] h
+    cdef double[::1] h, h_ref
     cdef double[:, ::1] pts
     keep = []             # the memoryviews behind the pointers, alive through the call
     try:
-        if cj == NULL or gj == NULL or found == NULL:
+        if cj == NULL or gj == NULL or mj == NULL or found == NULL or moved == NULL:
             raise MemoryError("cut_rows")
+        for a in range(3):
+            L[a] = float(lengths[a]) if lengths is not None and a < len(lengths) else 0.0
+        for j in range(nm):
+            coords, refs, h, h_ref, parts = motions[j]
+            mj[j].n = h.shape[0]
+            if h_ref.shape[0] != mj[j].n or len(coords) < g.dim or len(refs) < g.dim:
+                raise ValueError("cut_rows: a motion's arrays do not match")
+            for a in range(3):
+                mj[j].x[a] = _coord_ptr(coords[a], mj[j].n) if a < g.dim else NULL
+                mj[j].r[a] = _coord_ptr(refs[a], mj[j].n) if a < g.dim else NULL
+            mj[j].h = &h[0] if mj[j].n else NULL
+            mj[j].h_ref = &h_ref[0] if mj[j].n else NULL
+            mj[j].parts = _parts_ptr(parts, mj[j].n, nt)
+            keep.append((h, h_ref, parts))
         for j in range(ng):
             coords, h, pts, parts = gathers[j]
             if pts.shape[0] < h.shape[0] or pts.shape[1] != 4:
@@ -1093,13 +1132,33 @@ def cut_rows(GridSpec grid, list jobs, list gathers, double radius_scale):
             cj[j].ends = _iptr(ends)
             cj[j].parts = _parts_ptr(parts, cj[j].nd, nt)
             keep.append((off, nbrs, h, pts, out, ends, parts))
-        if ng:
+        if ng or nm:
             for k in prange(nt, nogil=True, schedule="static", num_threads=nt):
+                moved[8 * k] = 0.0        # largest |dx|^2
+                moved[8 * k + 1] = 0.0    # largest |dh|
+                moved[8 * k + 2] = 0.0    # count of non-finite results
+                for j in range(nm):
+                    lo = _cut(mj[j].parts, mj[j].n, k, nt)
+                    hi = _cut(mj[j].parts, mj[j].n, k + 1, nt)
+                    if hi > lo:
+                        _motion_chunk(g.dim, mj[j].x, mj[j].r, L, mj[j].h, mj[j].h_ref, lo, hi,
+                                      &moved[8 * k + 3])
+                        moved[8 * k + 2] += (not isfinite(moved[8 * k + 3])) + (not isfinite(moved[8 * k + 4]))
+                        moved[8 * k] = max(moved[8 * k], moved[8 * k + 3])
+                        moved[8 * k + 1] = max(moved[8 * k + 1], moved[8 * k + 4])
                 for j in range(ng):
                     lo = _cut(gj[j].parts, gj[j].n, k, nt)
                     hi = _cut(gj[j].parts, gj[j].n, k + 1, nt)
                     for i in range(lo, hi):
                         _record(gj[j].out, gj[j].x, gj[j].h, i, radius_scale)
+        if nm:
+            for k in range(nt):
+                if moved[8 * k + 2] != 0.0:
+                    return None
+                m2 = max(m2, moved[8 * k])
+                mh = max(mh, moved[8 * k + 1])
+            if not (2.0 * sqrt(m2) + radius_scale * mh <= skin_distance):
+                return None
         for k in prange(nt, nogil=True, schedule="static", num_threads=nt):
             for j in range(nj):
                 lo = _cut(cj[j].parts, cj[j].nd, k, nt)
@@ -1109,7 +1168,9 @@ def cut_rows(GridSpec grid, list jobs, list gathers, double radius_scale):
     finally:
         free(cj)
         free(gj)
+        free(mj)
         free(found)
+        free(moved)
 
 
 def refine_csr(GridSpec grid, int[::1] offsets, int[::1] nbrs, list dest_coords,
