@@ -146,7 +146,8 @@ def test_show_plan_reports_every_pass_in_order():
 
 def test_a_pass_over_other_arrays_only_is_scheduled_in_dynamic_chunks():
     """A wall that only sees the fluid gets dynamic chunks (most wall particles may have no
-    neighbour); a pass whose destination is among its sources runs the array's thread parts."""
+    neighbour); a pass whose destination is among its sources runs the array's thread parts,
+    each thread its own first, CLAIM particles at a time, then what is left of the others'."""
     from sphgen.codegen.render import render
     fluid, wall = lattice_cloud("fluid", nx=6), lattice_cloud("wall", nx=6, seed=1)
     sc = Scene([fluid, wall], [Group([SummationDensity("wall", ["fluid"])]),
@@ -156,4 +157,6 @@ def test_a_pass_over_other_arrays_only_is_scheduled_in_dynamic_chunks():
     src = render(sc.plan).source
     loops = dict(re.findall(r"prange\((\w+)_n, num_threads=_nthreads, (schedule=[^)]*)\):\n\s+_pass", src))
     assert loops == {"wall": "schedule='dynamic', chunksize=64"}
-    assert re.search(r"for d_idx in range\(_part_fluid\[k\], _part_fluid\[k \+ 1\]\):\n\s+_pass_\w+_fluid", src)
+    assert re.search(r"_claim\[8 \* k\] = _part_fluid\[k\]", src)
+    assert re.search(r"end = _part_fluid\[owner \+ 1\]\n\s+lo = sphgen_claim\(&_claim\[8 \* owner\], CLAIM\)", src)
+    assert re.search(r"for d_idx in range\(lo, hi\):\n\s+_pass_\w+_fluid\(d_idx, t, dt\)", src)

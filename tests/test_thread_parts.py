@@ -5,7 +5,7 @@ number of particles: a free surface or a finer region leaves one side with fewer
 import numpy as np
 import pytest
 
-from sphgen.equation import Group
+from sphgen.equation import Equation, Group
 from sphgen.equations.basic import SummationDensity
 from sphgen.scene import Scene
 
@@ -68,3 +68,35 @@ def test_parts_follow_the_thread_count_and_do_not_change_results():
     assert two.engine.parts("fluid") == [0, n]
     two.set_threads(2)
     assert two.engine.parts("fluid")[1] not in (0, n // 2, n)
+
+
+class _Visit(Equation):
+    """Counts the times a pass computes each particle (no initialize: every visit adds)."""
+
+    def loop(self, d_idx, d_visits, s_idx, s_m, WIJ):
+        d_visits[d_idx] += 0.0 * WIJ
+
+    def post_loop(self, d_idx, d_visits):
+        d_visits[d_idx] += 1.0
+
+
+@pytest.mark.parametrize("threads", [2, 4])
+def test_a_pass_computes_every_particle_once_whichever_thread_takes_it(threads):
+    """Each thread takes its part CLAIM particles at a time, then what is left of the
+    others' parts; with more threads than cores (parts finished out of turn: taken over)
+    every particle is still computed exactly once per pass, and the sums are those of one
+    thread."""
+    clouds = [lattice_cloud("fluid", nx=40, seed=7, visits=np.zeros(1600)) for _ in range(2)]
+    for c in clouds:
+        c.h[c.n // 3:] *= 1.5                # uneven work along the index order
+    eqs = [Group([SummationDensity("fluid", ["fluid"]), _Visit("fluid", ["fluid"])])]
+    sc, ref = (Scene([c], eqs, dim=2, threads=th, outputs={"fluid": ["rho", "visits"]})
+               for c, th in zip(clouds, (threads, 1)))
+    fluid = clouds[0]
+    for s in (sc, ref):
+        s.update_nnps()
+    for _ in range(200):
+        sc.compute(0, 0.0, 0.0)
+    ref.compute(0, 0.0, 0.0)
+    np.testing.assert_array_equal(fluid.visits, np.full(fluid.n, 200.0))
+    np.testing.assert_array_equal(fluid.rho, clouds[1].rho)
