@@ -45,7 +45,7 @@ class BuildExt(build_ext):
 
 extensions = [
     Extension("sphgen.nnps._cell_list", ["sphgen/nnps/_cell_list.pyx"],
-              include_dirs=[numpy.get_include()],
+              include_dirs=[numpy.get_include(), "sphgen/nnps"],
               define_macros=[("NPY_NO_DEPRECATED_API", "NPY_1_7_API_VERSION")]),
 ]
 
@@ -58,7 +58,7 @@ setup(
               "sphgen.equations", "sphgen.schemes", "sphgen.applications"],
     package_dir={"sphgen.equations": "equations", "sphgen.schemes": "schemes",
                  "sphgen.applications": "applications"},
-    package_data={"sphgen.codegen": ["*.mako"], "sphgen.nnps": ["*.pyx"],
+    package_data={"sphgen.codegen": ["*.mako"], "sphgen.nnps": ["*.pyx", "*.h"],
                   "sphgen.tools": ["reference/*"]},
     ext_modules=cythonize(extensions, language_level=3),
     cmdclass={"build_ext": BuildExt},

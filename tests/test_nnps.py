@@ -629,3 +629,28 @@ def test_cut_of_many_lists_with_thread_parts_is_repeatable():
         for key, (starts, ends, nbrs, pairs) in zip(keys, nn.rows_of(keys, parts)):
             assert_same_lists(packed(starts, ends, nbrs), expected[key])
             assert pairs == int(expected[key][0][-1])
+
+
+def test_the_cut_gives_the_same_rows_whatever_rows_a_thread_takes_at_a_time():
+    """cut_rows' threads take their own part's rows CUT_CLAIM at a time, then what is left
+    of the others' parts: the rows and pair counts do not depend on the claim size (1 row,
+    a few, a whole part: the static cut) nor on where the parts are cut."""
+    from sphgen.nnps._cell_list import set_cut_claim
+    rng = np.random.default_rng(77)
+    f = make_array("f", 700, 2, rng, h=0.04, hvar=0.2)
+    nn = NeighbourSearch([f], 2, 2.0, sort=False, skin=0.2)
+    _drift(f, 2, 0, 1e-4)
+    nn.update()
+    expected = packed(*nn.rows("f", "f")[:3])
+    old = set_cut_claim(64)
+    try:
+        for claim in (1, 7, 64, 1 << 40):
+            set_cut_claim(claim)
+            for cut in (0, 1, 350, 699, 700):
+                nn._row_cache = {}
+                nn._points = {}
+                starts, ends, nbrs, pairs = nn.rows_of([("f", "f")], {"f": np.array([0, cut, 700])})[0]
+                assert_same_lists(packed(starts, ends, nbrs), expected)
+                assert pairs == expected[0][-1]
+    finally:
+        set_cut_claim(old)

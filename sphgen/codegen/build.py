@@ -85,13 +85,22 @@ CFLAGS = ["-O3", "-march=native", "-fno-math-errno", "-fno-trapping-math", "-ffp
 _SRC_PATH = re.compile(r"^(\s*# @src ).*?([^/\\]+:\d+)$", re.M)
 
 
+INCLUDE = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "nnps")
+
+
+def _header_text():
+    """The C header the generated modules include (sphgen/nnps/sphgen_claim.h)."""
+    with open(os.path.join(INCLUDE, "sphgen_claim.h")) as f:
+        return f.read()
+
+
 def module_hash(source):
     """Hash of what the module is: the source with the ``# @src`` comments reduced to
     ``file:line`` (two clones of the project share cached modules), compiler flags and
     the versions the build depends on."""
     import Cython
     key = "\n".join([_SRC_PATH.sub(r"\1\2", source), " ".join(CFLAGS + openmp_flags()), Cython.__version__, numpy.__version__,
-                     sys.version, platform.machine(), _cpu_model()])
+                     sys.version, platform.machine(), _cpu_model(), _header_text()])
     return hashlib.sha256(key.encode()).hexdigest()[:20]
 
 
@@ -126,7 +135,7 @@ def _build(name, source, d, origin):
         f.write(source)
     os.replace(tmp, pyx)
     omp = openmp_flags()
-    ext = Extension(name, [pyx], include_dirs=[numpy.get_include()],
+    ext = Extension(name, [pyx], include_dirs=[numpy.get_include(), INCLUDE],
                     extra_compile_args=CFLAGS + omp, extra_link_args=omp,
                     define_macros=[("NPY_NO_DEPRECATED_API", "NPY_1_7_API_VERSION")])
     out = io.StringIO()

@@ -18,18 +18,7 @@ cdef extern from *:
     #endif
     """
     void sphgen_set_omp_threads(int n) noexcept nogil
-cdef extern from *:
-    """
-    /* the first of n items of a shared counter, taken atomically */
-    static inline long sphgen_claim(long* counter, long n) {
-        long first;
-    #ifdef _OPENMP
-        #pragma omp atomic capture
-    #endif
-        { first = *counter; *counter += n; }
-        return first;
-    }
-    """
+cdef extern from "sphgen_claim.h":     # sphgen/nnps/sphgen_claim.h
     long sphgen_claim(long* counter, long n) noexcept nogil
 cnp.import_array()
 

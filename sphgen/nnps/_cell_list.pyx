@@ -64,6 +64,21 @@ cdef extern from *:
     #endif
     """
     int sphgen_max_threads() noexcept nogil
+cdef extern from "sphgen_claim.h":
+    long sphgen_claim(long* counter, long n) noexcept nogil
+
+# rows of a list a thread of cut_rows takes at a time
+cdef Py_ssize_t CUT_CLAIM = 64
+
+
+def set_cut_claim(Py_ssize_t rows):
+    """Set the rows a thread of :func:`cut_rows` takes at a time (at least 1; a huge
+    value gives each thread its own part whole, the static cut); returns the previous
+    value.  For tests and measurements."""
+    global CUT_CLAIM
+    old = CUT_CLAIM
+    CUT_CLAIM = max(1, rows)
+    return old
 
 
 cdef Py_ssize_t _static_parts(Py_ssize_t n) noexcept nogil:
@@ -1082,6 +1097,9 @@ def cut_rows(GridSpec grid, list jobs, list gathers, double radius_scale, list m
     cdef GatherJob* gj = <GatherJob*>malloc((ng + 1) * sizeof(GatherJob))
     cdef MotionJob* mj = <MotionJob*>malloc((nm + 1) * sizeof(MotionJob))
     cdef Py_ssize_t* found = <Py_ssize_t*>malloc((nj * nt + 1) * sizeof(Py_ssize_t))
+    # where the unclaimed rows of part k of list j start (one cache line each)
+    cdef long* claims = <long*>malloc((8 * nj * nt + 1) * sizeof(long))
+    cdef int o, owner
     # per thread: largest |dx|^2 and |dh| of its parts (8 doubles apart: no shared line)
     cdef double* moved = <double*>malloc((8 * nt + 2) * sizeof(double))
     cdef int[::1] off, nbrs, out, ends
@@ -1089,7 +1107,7 @@ def cut_rows(GridSpec grid, list jobs, list gathers, double radius_scale, list m
     cdef double[:, ::1] pts
     keep = []             # the memoryviews behind the pointers, alive through the call
     try:
-        if cj == NULL or gj == NULL or mj == NULL or found == NULL or moved == NULL:
+        if cj == NULL or gj == NULL or mj == NULL or found == NULL or moved == NULL or claims == NULL:
             raise MemoryError("cut_rows")
         for a in range(3):
             L[a] = float(lengths[a]) if lengths is not None and a < len(lengths) else 0.0
@@ -1159,11 +1177,22 @@ def cut_rows(GridSpec grid, list jobs, list gathers, double radius_scale, list m
                 mh = max(mh, moved[8 * k + 1])
             if not (2.0 * sqrt(m2) + radius_scale * mh <= skin_distance):
                 return None
+        # thread k cuts its own part of each list first, CUT_CLAIM rows at a time, then what
+        # is left of the others' parts of that list (a slowed core hands over its rest)
+        for j in range(nj):
+            for k in range(nt):
+                claims[8 * (j * nt + k)] = _cut(cj[j].parts, cj[j].nd, k, nt)
         for k in prange(nt, nogil=True, schedule="static", num_threads=nt):
             for j in range(nj):
-                lo = _cut(cj[j].parts, cj[j].nd, k, nt)
-                hi = _cut(cj[j].parts, cj[j].nd, k + 1, nt)
-                found[j * nt + k] = _cut_part(g, open_box, &cj[j], lo, hi, radius_scale)
+                cnt = 0
+                for o in range(nt):
+                    owner = (k + o) % nt
+                    hi = _cut(cj[j].parts, cj[j].nd, owner + 1, nt)
+                    lo = sphgen_claim(&claims[8 * (j * nt + owner)], CUT_CLAIM)
+                    while lo < hi:
+                        cnt = cnt + _cut_part(g, open_box, &cj[j], lo, min(lo + CUT_CLAIM, hi), radius_scale)
+                        lo = sphgen_claim(&claims[8 * (j * nt + owner)], CUT_CLAIM)
+                found[j * nt + k] = cnt
         return [sum(found[j * nt + k] for k in range(nt)) for j in range(nj)]
     finally:
         free(cj)
@@ -1171,6 +1200,7 @@ def cut_rows(GridSpec grid, list jobs, list gathers, double radius_scale, list m
         free(mj)
         free(found)
         free(moved)
+        free(claims)
 
 
 def refine_csr(GridSpec grid, int[::1] offsets, int[::1] nbrs, list dest_coords,
