@@ -380,17 +380,43 @@ def load_application(name):
     return classes[0]
 
 
+class _PipeTolerant:
+    """sys.stdout for the command line: once its reader has gone (``sphgen run ... | head``),
+    the rest goes to /dev/null (Python's own advice) instead of failing the command with a
+    traceback half-way through writing its results."""
+
+    def __init__(self, stream):
+        self._stream = stream
+
+    def write(self, text):
+        try:
+            return self._stream.write(text)
+        except BrokenPipeError:
+            self._drop()
+            return len(text)
+
+    def flush(self):
+        try:
+            self._stream.flush()
+        except BrokenPipeError:
+            self._drop()
+
+    def _drop(self):
+        os.dup2(os.open(os.devnull, os.O_WRONLY), self._stream.fileno())
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
+
+
 def _print_to_pipe(text):
-    """Print ``text``; a reader that closes the pipe early (``sphgen list | head``) is no error."""
-    try:
-        print(text, flush=True)
-    except BrokenPipeError:
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())   # Python's own advice
+    print(text, flush=True)
     return 0
 
 
 def main(argv=None):
     argv = sys.argv[1:] if argv is None else argv
+    if not isinstance(sys.stdout, _PipeTolerant):
+        sys.stdout = _PipeTolerant(sys.stdout)
     if not argv or argv[0] in ("-h", "--help"):
         print("usage: sphgen run NAME [options] | sphgen precision NAME ... | sphgen stress NAME ... "
               "| sphgen list\n"

@@ -166,3 +166,19 @@ def test_sphgen_list_into_a_closed_pipe_is_no_traceback():
     err = p.stderr.read().decode()
     p.stderr.close()
     assert p.wait() == 0 and err == ""
+
+
+def test_a_run_into_a_closed_pipe_writes_its_results_and_no_traceback(tmp_path):
+    """``sphgen run ... | head -1``: the reader leaves early (here before the first line);
+    the run still post-processes (results.json, figures) and exits 0 without a traceback."""
+    out = tmp_path / "db"
+    p = subprocess.Popen([sys.executable, "-m", "sphgen", "run", "dam_break_2d", "--tf", "0.002",
+                          "--no-progress", "--threads", "1", "--disable-output", "-d", str(out)],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                         cwd=os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    p.stdout.close()
+    err = p.stderr.read().decode()
+    p.stderr.close()
+    assert p.wait() == 0 and "Traceback" not in err, err
+    assert (out / "results.json").exists() and (out / "toe.png").exists()
+    assert json.load(open(out / "info.json"))["completed"]
