@@ -220,7 +220,8 @@ class NeighbourSearch:
     def update(self):
         """Wrap positions into the periodic box (in place, periodic axes only),
         rebuild the cell lists (unless a skin still covers the motion since the last
-        rebuild) and drop the cached neighbour lists."""
+        rebuild) and drop the cached neighbour lists; with a skin, the rows the last update
+        cut are cut anew here, in the same call as the skin check (:meth:`_refresh`)."""
         self.n_updates += 1
         if self._built_at is not None:
             kept = self._refresh()
