@@ -485,7 +485,7 @@ class NeighbourSearch:
                     if first:         # the lists an update needs: cut them at the next ones
                         self._plan_refresh(cut, parts or {})
         elif self._plan is not None and parts is not None and not _same_parts(parts, self._plan["parts"]):
-            self._plan = None         # other thread parts: planned anew at the next cut
+            self._plan_refresh(self._plan["cut"], parts)   # the module cut its parts anew
         return [self._row_cache[(d.name, s.name)] for d, s in keys]
 
     def _plan_refresh(self, cut, parts):
@@ -496,6 +496,8 @@ class NeighbourSearch:
         if self._built_at is None:
             return
         gathers, records = [], {}
+        if any(s.name not in self._points for _, s, _ in cut):
+            return                    # records not gathered this update: planned at the next cut
         for d, s, lists in cut:
             if s.name not in records:
                 records[s.name] = self._points[s.name]
@@ -507,7 +509,7 @@ class NeighbourSearch:
                    for pa in self.arrays for ref in [self._built_at[pa.name]] if pa.n]
         arrays = [(pa, pa.n, [(p, pa.get(p)) for p in _AXES[:self.dim] + ("h",)]) for pa in self.arrays]
         self._plan = {"jobs": jobs, "gathers": gathers, "motions": motions, "records": records,
-                      "kept": kept, "arrays": arrays, "parts": parts}
+                      "kept": kept, "arrays": arrays, "parts": parts, "cut": cut}
 
     def _cut_rows(self, todo, parts):
         """{(dest, src): rows} cut in place from the skin lists of ``todo`` ((d, s, lists)
