@@ -35,7 +35,7 @@ minimum image, computed as ``(x_i - x_j) -/+ L`` like the usual formula); an axi
 with fewer cells visits every cell once and takes the minimum image pair by pair.
 """
 from cython.parallel cimport prange
-from libc.math cimport fabs, floor, isfinite, round, sqrt
+from libc.math cimport INFINITY, fabs, floor, isfinite, round, sqrt
 from libc.stdlib cimport free, malloc, realloc
 from libc.string cimport memcpy
 
@@ -948,50 +948,91 @@ cdef inline void _record(double* out, const double** x, const double* h, Py_ssiz
     out[4 * i + 3] = kh * kh
 
 
+cdef inline Py_ssize_t _cut_open(const int* nbrs, Py_ssize_t k0, Py_ssize_t k1, double xi,
+                                 double yi, double zi, double ri2, const double* pts,
+                                 int* out) noexcept nogil:
+    """:func:`_refine_row` where no candidate is across a periodic edge: no per-candidate
+    axis tests; in 2D the z terms are 0 - 0 (pts holds 0 there), and adding 0.0 leaves
+    the build's sum unchanged."""
+    cdef Py_ssize_t k, cnt = 0
+    cdef const double* q
+    cdef double dx, dy, dz, r2
+    for k in range(k0, k1):
+        q = pts + 4 * nbrs[k]
+        dx = xi - q[0]
+        dy = yi - q[1]
+        dz = zi - q[2]
+        r2 = dx * dx + dy * dy + dz * dz
+        out[cnt] = nbrs[k]
+        cnt = cnt + (r2 < (ri2 if ri2 > q[3] else q[3]))
+    return cnt
+
+
+cdef inline bint _off_the_edges(const Grid* g, double xi, double yi, double zi) noexcept nogil:
+    """True if ``(xi, yi, zi)`` lies more than a cell inside every periodic edge (of an
+    axis of three cells or more).  No pair of a skin list that is in reach now is then
+    across an edge, so the plain difference of the wrapped coordinates is the minimum
+    image: such a pair is closer than the cut-off now, which is at most the cut-off plus
+    the skin at the build (the skin check bounds the growth of h), at most a cell.  A
+    candidate out of reach stays out: the plain difference is never shorter than the
+    minimum image."""
+    cdef double x[3]
+    cdef int a
+    x[0] = xi
+    x[1] = yi
+    x[2] = zi
+    for a in range(g.dim):
+        if g.periodic[a] and (g.all_cells[a] or not (g.lo[a] + g.cs[a] < x[a] < g.lo[a] + g.length[a] - g.cs[a])):
+            return False
+    return True
+
+
 cdef inline Py_ssize_t _refine_row(const Grid* g, bint open_box, Py_ssize_t i, const int* nbrs,
                                    Py_ssize_t k0, Py_ssize_t k1, const double* xd0, const double* xd1,
                                    const double* xd2, double ri2, const double* pts,
                                    int* out) noexcept nogil:
     """Copy to ``out`` the candidates ``nbrs[k0:k1]`` of destination ``i`` in reach now
     (``|r_ij|^2 < max((k h_i)^2, (k h_j)^2)``, the test of :func:`build_csr` term for
-    term); returns how many."""
+    term); returns how many.  The candidates must come from a skin list whose skin still
+    covers the motion (rows off the periodic edges skip the minimum image)."""
     cdef Py_ssize_t k, cnt = 0
     cdef const double* q
-    cdef double dx, dy, dz, r2, xi, yi, zi
+    cdef double dx, dy, dz, r2, xi, yi, zi, hx, hy, hz, lx, ly, lz
     if k1 <= k0:      # most rows of a wall list are empty: no loads for them
         return 0
     xi = xd0[i]
     yi = xd1[i] if g.dim >= 2 else 0.0
     zi = xd2[i] if g.dim == 3 else 0.0
-    if open_box:  # no per-candidate axis tests; in 2D the z terms are 0 - 0 (pts holds 0
-        # there), and adding 0.0 leaves the build's sum unchanged
-        for k in range(k0, k1):
-            q = pts + 4 * nbrs[k]
-            dx = xi - q[0]
-            dy = yi - q[1]
-            dz = zi - q[2]
-            r2 = dx * dx + dy * dy + dz * dz
-            out[cnt] = nbrs[k]
-            cnt = cnt + (r2 < (ri2 if ri2 > q[3] else q[3]))
-        return cnt
+    if open_box or _off_the_edges(g, xi, yi, zi):
+        return _cut_open(nbrs, k0, k1, xi, yi, zi, ri2, pts, out)
+    # near a periodic edge: the minimum image on periodic axes (half = inf on the others,
+    # so their tests never fire), the z terms 0 in 2D and y, z in 1D as above.  The box is
+    # read into locals first: with -fno-strict-aliasing every store to ``out`` would
+    # otherwise reload g's fields
+    hx = g.half[0] if g.periodic[0] else INFINITY
+    hy = g.half[1] if g.periodic[1] else INFINITY
+    hz = g.half[2] if g.periodic[2] else INFINITY
+    lx = g.length[0]
+    ly = g.length[1]
+    lz = g.length[2]
     for k in range(k0, k1):
         q = pts + 4 * nbrs[k]
         dx = xi - q[0]
-        if g.periodic[0]:
-            dx = _min_image(g, 0, dx)
-        if g.dim == 1:
-            r2 = dx * dx
-        else:
-            dy = yi - q[1]
-            if g.periodic[1]:
-                dy = _min_image(g, 1, dy)
-            if g.dim == 2:
-                r2 = dx * dx + dy * dy
-            else:
-                dz = zi - q[2]
-                if g.periodic[2]:
-                    dz = _min_image(g, 2, dz)
-                r2 = dx * dx + dy * dy + dz * dz
+        if dx > hx:
+            dx = dx - lx
+        elif dx < -hx:
+            dx = dx + lx
+        dy = yi - q[1]
+        if dy > hy:
+            dy = dy - ly
+        elif dy < -hy:
+            dy = dy + ly
+        dz = zi - q[2]
+        if dz > hz:
+            dz = dz - lz
+        elif dz < -hz:
+            dz = dz + lz
+        r2 = dx * dx + dy * dy + dz * dz
         out[cnt] = nbrs[k]
         cnt = cnt + (r2 < (ri2 if ri2 > q[3] else q[3]))
     return cnt
