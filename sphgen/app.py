@@ -122,6 +122,9 @@ class Application:
                             "cells and candidate lists are kept while it covers the motion "
                             "(the neighbour lists, and so the results, are the same; default "
                             "%(default)s)")
+        g.add_argument("--tune-skin", action="store_true",
+                       help="choose the skin of each rebuild by timing the neighbour upkeep, "
+                            "starting from --skin (the results are the same)")
         g.add_argument("--max-steps", type=_positive_int, default=None, help="stop after this many steps")
         g.add_argument("--openmp", dest="openmp", action="store_true", default=True,
                        help="use all cores (default)")
@@ -204,7 +207,7 @@ class Application:
                      kernel=getattr(self.scheme, "kernel", None), dim=self.dim,
                      domain=self.create_domain(), outputs=outputs, backend=opts.backend,
                      threads=1 if not opts.openmp else opts.threads, skin=opts.skin,
-                     evaluated=integrator.evaluated_sets())
+                     evaluated=integrator.evaluated_sets(), tune_skin=opts.tune_skin)
 
     def _solver(self, integrator, dt):
         opts = self.options
@@ -345,6 +348,7 @@ class Application:
             "neighbour_pairs_per_step": self.neighbour_pairs_per_step() if completed else None,
             "estimated_pair_flops_per_step": self.neighbour_pairs_per_step(flops=True) if completed else None,
             "neighbour_updates": sc.nnps.n_updates, "neighbour_builds": sc.nnps.n_builds,
+            "skin": sc.nnps.skin, "skin_choices": sc.skin_tuner.choices if sc.skin_tuner else [],
             "generated_source": getattr(sc, "source_path", None),
             "restarts": self.restarts, "options": vars(opts),
             **({"timing": self.timing_report()[1]} if self.timers is not None else {}),

@@ -17,6 +17,7 @@ from .codegen.passes import plan_scene
 from .evaluator import PythonEvaluator
 from .kernels import QuinticSpline
 from .nnps import NeighbourSearch
+from .nnps.skin_tuner import SkinTuner
 
 BACKENDS = {"cython": CompiledBackend, "python": PythonEvaluator}
 
@@ -25,7 +26,8 @@ class Scene:
     """Everything one simulation computes, specialised and compiled once."""
 
     def __init__(self, arrays, equations, steppers=None, kernel=None, dim=2, domain=None,
-                 outputs=None, backend="cython", threads=None, skin=0.0, evaluated=None):
+                 outputs=None, backend="cython", threads=None, skin=0.0, evaluated=None,
+                 tune_skin=False):
         if backend not in BACKENDS:
             raise ValueError(f"backend must be {' or '.join(map(repr, BACKENDS))}, got {backend!r}")
         self.arrays = list(arrays)
@@ -47,6 +49,11 @@ class Scene:
                 pa.allocate(p)
         self.nnps = NeighbourSearch(self.searched_arrays(), dim, self.kernel.radius_scale, domain,
                                     skin=skin)
+        # the skin of the next rebuilds chosen by timing (results unchanged: exact lists)
+        self.skin_tuner = (SkinTuner(skin, dim, lowest=min(0.025, skin), highest=max(0.5, skin))
+                           if tune_skin and skin > 0 else None)
+        self._builds_seen = 0    # rebuilds the tuner has seen (a sort rebuilds too)
+        self._clock = time.perf_counter
         self.backend = backend
         self.engine = BACKENDS[backend](self.plan, self.nnps)
         self.setup_time = time.perf_counter() - t0
@@ -86,8 +93,19 @@ class Scene:
     # ---------------------------------------------------------------- running
     def update_nnps(self):
         """Rebuild neighbour lists after positions changed."""
-        self.nnps.update()
+        tuner = self.skin_tuner
+        if tuner is None:
+            self.nnps.update()
+            self.engine.bind_neighbours()
+            return
+        nnps, before, skin = self.nnps, self.nnps.n_builds, self.nnps.skin
+        if before != self._builds_seen:     # a sort rebuilt the lists since the last update
+            tuner.interrupt()
+        start = self._clock()
+        nnps.update()
         self.engine.bind_neighbours()
+        self._builds_seen = nnps.n_builds
+        nnps.skin = tuner.record(self._clock() - start, nnps.n_builds != before, skin)
 
     def compute(self, index, t, dt):
         """Run evaluation ``index`` (any index if there is only one equation set)."""

@@ -170,6 +170,7 @@ class NeighbourSearch:
         if not (math.isfinite(skin) and skin >= 0):
             raise ValueError(f"NeighbourSearch: skin must be >= 0, got {skin}")
         self.skin = skin
+        self.sort_skin = skin    # the skin of the cells that :meth:`sort` orders by
         self.skin_distance = 0.0
         self._periodic_lengths = [domain.length[a] if domain.periodic[a] else 0.0 for a in range(self.dim)]
         self.n_updates = 0
@@ -583,8 +584,15 @@ class NeighbourSearch:
     def sort(self):
         """Spatially sort every array (particles of one cell contiguous, cells in
         Morton order) with ``pa.permute(perm)``, remap the frozen reference lists
-        and rebuild.  Returns ``{name: perm}`` with ``new[k] = old[perm[k]]``."""
-        self._build()
+        and rebuild.  Returns ``{name: perm}`` with ``new[k] = old[perm[k]]``.  The cells of
+        the order are those of the skin given at construction, whatever ``skin`` is now
+        (a :class:`~sphgen.nnps.skin_tuner.SkinTuner` changes it): the order, and so the
+        sums of the passes, do not depend on the skin, and neither do the results."""
+        skin, self.skin = self.skin, self.sort_skin
+        try:
+            self._build()
+        finally:
+            self.skin = skin
         perms, inverse = {}, {}
         for pa in self.arrays:
             perm = self._bins[pa.name][1].copy()
