@@ -172,7 +172,10 @@ class Application:
             raise SystemExit(e.exit_code) from None
 
     def _run(self, argv):
-        opts = self.options = self.parser().parse_args(argv)
+        parser = self.parser()
+        opts = self.options = parser.parse_args(argv)
+        if opts.tune_skin and opts.skin <= 0:
+            parser.error("--tune-skin chooses among skins: give --skin above 0")
         self.consume_user_options(opts)
         self.outdir = outdir = opts.directory or f"{self.name}_output"
         restart = run_folder.read_restart(opts.restart) if opts.restart else None

@@ -140,3 +140,14 @@ def test_a_run_with_the_skin_tuned_gives_the_same_results(tmp_path, monkeypatch)
             assert app.scene.nnps.skin == 0.5
     for p in finals[False]:
         np.testing.assert_array_equal(finals[True][p], finals[False][p])
+
+
+def test_tuning_without_a_skin_is_one_clear_line(tmp_path, capsys):
+    out = tmp_path / "run"
+    with pytest.raises(SystemExit) as e:
+        load_application("taylor_green")().run(["--skin", "0", "--tune-skin", "-d", str(out)])
+    assert e.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["sphgen: --tune-skin chooses among skins: give --skin above 0 "
+                   "(see sphgen run taylor_green --help)"]
+    assert not out.exists()
