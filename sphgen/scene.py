@@ -53,7 +53,7 @@ class Scene:
         self.skin_tuner = (SkinTuner(skin, dim, lowest=min(0.025, skin), highest=max(0.5, skin))
                            if tune_skin and skin > 0 else None)
         self._builds_seen = 0    # rebuilds the tuner has seen (a sort rebuilds too)
-        self._clock = time.perf_counter
+        self._clock = time.perf_counter    # the tuner's clock
         self.backend = backend
         self.engine = BACKENDS[backend](self.plan, self.nnps)
         self.setup_time = time.perf_counter() - t0
@@ -92,7 +92,8 @@ class Scene:
 
     # ---------------------------------------------------------------- running
     def update_nnps(self):
-        """Rebuild neighbour lists after positions changed."""
+        """Rebuild neighbour lists after positions changed (timed for the skin tuner, if any,
+        which then sets the skin of the next rebuilds)."""
         tuner = self.skin_tuner
         if tuner is None:
             self.nnps.update()
