@@ -227,6 +227,18 @@ class DamBreakVariational(Application):
             self._next_record = solver.t + self.options.record_every
 
     # ------------------------------------------------------------ results
+    def ejected_final(self, outdir):
+        """Ejected fluid particles at the end: from the last output file, or from the state
+        in memory if the run wrote none (``--disable-output``)."""
+        if io.output_files(outdir):
+            x, y = final_positions(outdir)
+        elif getattr(self, "solver", None) is not None:
+            f = self.scene.by_name["fluid"]
+            x, y = f.x, f.y
+        else:
+            return None
+        return int(ejected(x, y).sum())
+
     def post_process(self, outdir):
         hist, rows = io.read_history(outdir)
         cols = {c: rows[:, i] for i, c in enumerate(hist["columns"])}
@@ -244,7 +256,7 @@ class DamBreakVariational(Application):
                                                        abs(cols["rho_max"].max() / RHO0 - 1.0))),
                         "energy_final": float(energy[-1]) / hist["E0"] - 1.0,
                         "energy_error": float(np.abs(energy / hist["E0"] - 1.0).max()),
-                        "ejected_final": int(ejected(*final_positions(outdir)).sum())})
+                        "ejected_final": self.ejected_final(outdir)})
         if self.options.reference_run:
             results.update(position_error(outdir, self.options.reference_run))
         refs = {"martin_moyce_a2.25in": reference.martin_moyce_1952(2.25),

@@ -96,7 +96,11 @@ class SHTCImpulseOfShear(SHTCShearWave):
         o = self.options
         nu, cs = o.nu, o.cs
         errors = []
-        for t, y, u, m in self.snapshots:
+        snapshots = self.snapshots
+        if not snapshots:     # stopped (--max-steps) before tf / 3: the state it reached
+            f = self.scene.by_name["fluid"]
+            snapshots = [(self.solver.t, f.y.copy(), f.u.copy(), f.m.copy())]
+        for t, y, u, m in snapshots:
             e = [math.sqrt(np.sum(m * (u - layer_solution(self.initial_velocity, y, t, nu, c)) ** 2) / np.sum(m))
                  / U_LAYER for c in (cs, math.inf)]
             errors.append((t, *e))

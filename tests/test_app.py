@@ -182,3 +182,19 @@ def test_a_run_into_a_closed_pipe_writes_its_results_and_no_traceback(tmp_path):
     assert p.wait() == 0 and "Traceback" not in err, err
     assert (out / "results.json").exists() and (out / "toe.png").exists()
     assert json.load(open(out / "info.json"))["completed"]
+
+
+@pytest.mark.parametrize("name", ["dam_break_variational", "shtc_impulse_of_shear"])
+def test_a_short_run_without_output_still_writes_its_results(name, tmp_path, capsys):
+    """Three steps with --disable-output: no output file to read back and (the shear
+    layer) no snapshot reached; post_process uses the state in memory.  Both raised an
+    IndexError before."""
+    out = tmp_path / name
+    load_application(name)().run(["--max-steps", "3", "--disable-output", "--no-progress", "--no-openmp",
+                                  "-d", str(out)])
+    results = json.load(open(out / "results.json"))
+    assert results["t"] > 0
+    if name == "dam_break_variational":
+        assert results["ejected_final"] == 0
+    else:
+        assert np.isfinite(results["profile_error"]) and results["profile_error"] < 1e-3
