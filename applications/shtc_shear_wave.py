@@ -94,6 +94,8 @@ class SHTCShearWave(Application):
     def post_process(self, outdir):
         """results.json: nu_measured / nu and the predicted viscosity_factor."""
         rows = np.array(self.history)
+        if rows.ndim != 2 or rows.shape[0] < 2:
+            raise InputError("shtc_shear_wave: no time step was taken, no decay to fit")
         t, a = rows[:, 0], rows[:, 1]
         late = t >= 0.5 * t[-1]
         nu = self.options.nu

@@ -141,7 +141,9 @@ class ThermoDisk(ThermoSolid):
         c = checks(self.history_columns, self.history, T, T)
         r = self.write_results(outdir, checks(self.history_columns, self.history, 0.0, T),
                                {"total_spread_after_heating": c["total_spread"]})
+        def g(key, spec):     # a check with too few samples (a short run) is None
+            return "n/a" if r[key] is None else format(r[key], spec)
         print(f"thermo_disk: N={r['n_particles']} t={self.solver.t:.4g} ({self.options.variant}, "
-              f"{self.options.form}-form): |dL|/sum V|p| {r['L_drift']:.2e}, |dA|/|A| {r['A_drift']:.2e}, "
-              f"energy residual {r['energy_residual']:.2e}, after the heat: E_tot spread {c['total_spread']}, "
-              f"S fall {r['entropy_fall']}, B rise {r['ballistic_rise']}; J_min {r['J_min']:.3f}")
+              f"{self.options.form}-form): |dL|/sum V|p| {g('L_drift', '.2e')}, |dA|/|A| {g('A_drift', '.2e')}, "
+              f"energy residual {g('energy_residual', '.2e')}, after the heat: E_tot spread {c['total_spread']}, "
+              f"S fall {r['entropy_fall']}, B rise {r['ballistic_rise']}; J_min {g('J_min', '.3f')}")

@@ -198,3 +198,17 @@ def test_a_short_run_without_output_still_writes_its_results(name, tmp_path, cap
         assert results["ejected_final"] == 0
     else:
         assert np.isfinite(results["profile_error"]) and results["profile_error"] < 1e-3
+
+
+def test_zero_steps_is_one_clear_line_or_a_result(tmp_path, capsys):
+    """--tf 0: the shear wave has no decay to fit (one line, exit 2; it raised IndexError);
+    the heated disk writes its checks, those that need two samples as n/a (it raised
+    TypeError formatting None)."""
+    with pytest.raises(SystemExit) as e:
+        load_application("shtc_shear_wave")().run(["--tf", "0", "--no-progress", "-d", str(tmp_path / "w")])
+    assert e.value.code == 2
+    assert capsys.readouterr().err.strip().splitlines() == [
+        "sphgen: shtc_shear_wave: no time step was taken, no decay to fit"]
+    load_application("thermo_disk")().run(["--tf", "0", "--no-progress", "-d", str(tmp_path / "d")])
+    assert "|dA|/|A| n/a" in capsys.readouterr().out
+    assert json.load(open(tmp_path / "d" / "results.json"))["A_drift"] is None
