@@ -44,6 +44,10 @@ class SHTCReversibility(BerylliumPlate):
             raise InputError(f"--steps must be at least 1, got {o.steps}")
         if not (math.isfinite(o.amplitude) and o.amplitude > 0):
             raise InputError(f"--amplitude must be positive, got {o.amplitude}")
+        if getattr(o, "restart", None):
+            raise InputError("shtc_reversibility: --restart cannot continue the forward-and-back run "
+                             "(its start and forward displacement are not in the output files); "
+                             "run it from the start")
         # the run is counted in steps: an end time never shortens the last step
         # (the plate's steps are ~1e-8 s: 1 s is never reached)
         o.max_steps, o.tf = 2 * o.steps, 1.0

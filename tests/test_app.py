@@ -212,3 +212,15 @@ def test_zero_steps_is_one_clear_line_or_a_result(tmp_path, capsys):
     load_application("thermo_disk")().run(["--tf", "0", "--no-progress", "-d", str(tmp_path / "d")])
     assert "|dA|/|A| n/a" in capsys.readouterr().out
     assert json.load(open(tmp_path / "d" / "results.json"))["A_drift"] is None
+
+
+def test_the_reversibility_run_refuses_a_restart_in_one_line(tmp_path, capsys):
+    """shtc_reversibility measures a forward-and-back run from its start; a restart used to
+    end in ZeroDivisionError (found by a restart sweep of every application)."""
+    out = tmp_path / "run"
+    with pytest.raises(SystemExit) as e:
+        load_application("shtc_reversibility")().run(["--restart", str(tmp_path / "any.h5"), "-d", str(out)])
+    assert e.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--restart cannot continue the forward-and-back run" in err[0]
+    assert not out.exists()
