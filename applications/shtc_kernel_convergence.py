@@ -115,6 +115,9 @@ class SHTCKernelConvergence(Application):
     def _run(self, argv):
         """No particles and no time loop: the study is a quadrature on a lattice."""
         opts = self.options = self.parser().parse_args(argv)
+        if opts.show_plan:
+            raise InputError(f"{self.name} compiles no scene (a quadrature on a lattice, no particles): "
+                             "there is no plan to show")
         self.consume_user_options(opts)
         self.outdir = opts.directory or f"{self.name}_output"
         run_folder.check_output_folder(self.outdir, opts.overwrite)

@@ -224,3 +224,16 @@ def test_the_reversibility_run_refuses_a_restart_in_one_line(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--restart cannot continue the forward-and-back run" in err[0]
     assert not out.exists()
+
+
+def test_show_plan_of_a_study_without_a_scene_is_one_line_and_writes_nothing(tmp_path, capsys):
+    """shtc_kernel_convergence has no compiled scene; --show-plan used to run the whole
+    study and write its folder (found by a --show-plan sweep of every application)."""
+    out = tmp_path / "run"
+    with pytest.raises(SystemExit) as e:
+        load_application("shtc_kernel_convergence")().run(["--show-plan", "-d", str(out)])
+    assert e.value.code == 2
+    assert capsys.readouterr().err.strip().splitlines() == [
+        "sphgen: shtc_kernel_convergence compiles no scene (a quadrature on a lattice, no particles): "
+        "there is no plan to show"]
+    assert not out.exists()
