@@ -69,9 +69,22 @@ def _read(path):
         return {}
 
 
+def check_runs(name, todo, what):
+    """Every run's options parsed by the application before any run starts (and before the
+    study's folder is made): a wrong option is one line, not a table of failed runs."""
+    from .app import load_application
+    parser = load_application(name)().parser()
+    for label, args in todo:
+        try:
+            parser.parse_args(list(args) + ["-d", os.devnull])
+        except InputError as e:
+            raise InputError(f"{what} {name}, run {label}: {e}") from None
+
+
 def run_all(name, todo, directory, jobs, what):
     """Run [(label, args)] into ``directory/<label>``, ``jobs`` at a time, with a progress bar."""
     from tqdm import tqdm
+    check_runs(name, todo, what)
     os.makedirs(directory, exist_ok=True)
     with ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
         futures = [pool.submit(run_one, name, args, os.path.join(directory, label)) for label, args in todo]
@@ -248,6 +261,12 @@ def stress(argv):
     p.add_argument("--stable-factor", type=float, default=1.0,
                    help="dt factor up to which the scheme documents stability (default 1)")
     o, rest = _parse(p, argv)
+    from .app import load_application
+    known = load_application(o.name)().parser()._option_string_actions
+    missing = [opt for opt in ("--perturb", "--seed") if opt not in known]
+    if missing:
+        raise InputError(f"stress {o.name}: the application has no {' or '.join(missing)} option; "
+                         "sphgen stress starts every run from a lattice perturbed at random")
     axes, fixed = split_sweep(rest)
     todo = []
     for label, args in cases(axes):

@@ -98,3 +98,20 @@ def test_reference_points_from_another_start_are_not_plotted():
     assert _same_start({"perturb": 0.1}, runs)
     assert not _same_start({}, runs)                    # an older file: the plain lattice
     assert _same_start({}, [{"info": {"options": {"nr": 10}}}])   # no --perturb option: nothing to compare
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["stress", "couette", "--runs", "1"], "stress couette: the application has no --perturb or --seed option"),
+    (["stress", "taylor_green", "--runs", "1", "--nx", "12", "--frobnicate", "3"],
+     "stress taylor_green, run run_seed0: unrecognized arguments: --frobnicate 3"),
+    (["precision", "taylor_green", "--nx", "12", "16", "--frobnicate", "3"],
+     "precision taylor_green, run nx12: unrecognized arguments: --frobnicate 3"),
+])
+def test_a_study_with_options_its_application_lacks_is_one_line_before_any_run(argv, words, tmp_path):
+    """Each such run used to be reported as blown up ("blew up: unrecognized arguments"),
+    after running the others: found by a stress sweep of every application."""
+    d = tmp_path / "study"
+    with pytest.raises(SystemExit) as e:
+        main(argv + ["-d", str(d)])
+    assert str(e.value).startswith("sphgen: " + words) and "\n" not in str(e.value)
+    assert not d.exists()
