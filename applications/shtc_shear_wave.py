@@ -95,7 +95,8 @@ class SHTCShearWave(Application):
         """results.json: nu_measured / nu and the predicted viscosity_factor."""
         rows = np.array(self.history)
         if rows.ndim != 2 or rows.shape[0] < 2:
-            raise InputError("shtc_shear_wave: no time step was taken, no decay to fit")
+            raise InputError("shtc_shear_wave: the decay needs two samples of the amplitude or more "
+                             "(run at least two steps)")
         t, a = rows[:, 0], rows[:, 1]
         late = t >= 0.5 * t[-1]
         nu = self.options.nu

@@ -201,14 +201,18 @@ def test_a_short_run_without_output_still_writes_its_results(name, tmp_path, cap
 
 
 def test_zero_steps_is_one_clear_line_or_a_result(tmp_path, capsys):
-    """--tf 0: the shear wave has no decay to fit (one line, exit 2; it raised IndexError);
+    """--tf 0 (and one step): the shear wave has no decay to fit (one line, exit 2; it raised
+    IndexError, and fitted a line through one point);
     the heated disk writes its checks, those that need two samples as n/a (it raised
     TypeError formatting None)."""
     with pytest.raises(SystemExit) as e:
         load_application("shtc_shear_wave")().run(["--tf", "0", "--no-progress", "-d", str(tmp_path / "w")])
     assert e.value.code == 2
     assert capsys.readouterr().err.strip().splitlines() == [
-        "sphgen: shtc_shear_wave: no time step was taken, no decay to fit"]
+        "sphgen: shtc_shear_wave: the decay needs two samples of the amplitude or more (run at least two steps)"]
+    with pytest.raises(SystemExit) as e:
+        load_application("shtc_shear_wave")().run(["--max-steps", "1", "--no-progress", "-d", str(tmp_path / "w1")])
+    assert e.value.code == 2 and "run at least two steps" in capsys.readouterr().err
     load_application("thermo_disk")().run(["--tf", "0", "--no-progress", "-d", str(tmp_path / "d")])
     assert "|dA|/|A| n/a" in capsys.readouterr().out
     assert json.load(open(tmp_path / "d" / "results.json"))["A_drift"] is None
