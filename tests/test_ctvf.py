@@ -400,7 +400,7 @@ def tg_whole_run(tmp_path, scheme, re, *extra, nx=50):
 @pytest.mark.slow
 @pytest.mark.parametrize("re", [100, pytest.param(1000, marks=pytest.mark.xfail(
     reason="measured (docs/ctvf.md): on the same 0.1 dx perturbed start CTVF + SPST peaks at 0.0395 "
-    "(at t = 2) against EDAC's 0.0306", strict=False))])
+    "(at t = 2) against EDAC's 0.0306", strict=True))])
 def test_ctvf_largest_l1_below_edac_and_gtvf(tmp_path, re):
     """nx 50, t = 2, largest L1 over the run, every scheme from the same 0.1 dx perturbed
     lattice (docs/ctvf.md): CTVF + SPST 0.0081 (Re 100) and 0.0395 (Re 1000), EDAC 0.0087
@@ -450,7 +450,7 @@ def test_ctvf_re1000_l1_falls_with_resolution(tmp_path, capsys):
 @pytest.mark.slow
 @pytest.mark.xfail(reason="measured (docs/ctvf.md): at 100 x 100, Re 1000, SPST the run without corrections "
                    "ends lower (L1 0.0113 against 0.0226 with them); the -u div(delta) term raises it",
-                   strict=False)
+                   strict=True)
 def test_ctvf_corrections_lower_the_l1_error(tmp_path):
     """Adepu & Ramachandran (2021) Fig. 10 (at 150 x 150 there; 100 x 100 here; plain lattice,
     as measured)."""
