@@ -4,6 +4,7 @@ import ast
 import pytest
 
 from sphgen.codegen import passes
+from sphgen.codegen.passes.specialise import check_switches
 from sphgen.codegen.plan import SceneError, new_plan
 from sphgen.equation import Equation
 from sphgen.equations.momentum import ArtificialViscosity
@@ -56,6 +57,43 @@ def test_a_zero_switch_drops_the_equation_and_a_nonzero_float_stays_a_parameter(
     src = ast.unparse(plan.eqplans[0].methods["loop"].fdef)
     assert "-ArtificialViscosity_0_alpha * ArtificialViscosity_0_c0 * phi" in src and "self" not in src
     assert plan.eqplans[0].methods["loop"].params_used == {"alpha", "c0"}
+
+
+def test_the_test_of_a_nonzero_switch_is_folded_away_its_value_stays_a_parameter():
+    """``if self.alpha != 0.0:`` around the only loads of a property kept gcc from
+    vectorising the pair loop; a non-zero switch now folds the test, not the value."""
+    plan, _ = _specialised([ArtificialViscosity("fluid", ["fluid"], alpha=0.5, c0=10.0)])
+    src = ast.unparse(plan.eqplans[0].methods["loop"].fdef)
+    assert "!= 0" not in src and "ArtificialViscosity_0_alpha != " not in src
+    assert src.splitlines()[1].startswith("    vr = ")          # the body, no longer under an if
+    assert "if vr < 0.0:" in src                                # the physics' own branch stays
+    assert plan.switches[0][1] == {"alpha": "non-zero"}
+
+
+class Switched(Equation):
+    switches = ("k",)
+
+    def loop(self, d_idx, d_s, s_idx, WIJ):
+        if self.k == 0.0:
+            d_s[d_idx] += WIJ
+        elif 0 != self.k:
+            d_s[d_idx] += self.k * WIJ
+
+
+@pytest.mark.parametrize("k, body", [(2.5, "d_s[d_idx] += Switched_0_k * WIJ"), (0.0, "d_s[d_idx] += WIJ")])
+def test_either_order_and_both_tests_of_a_switch_fold(k, body):
+    plan, _ = _specialised([Switched("fluid", ["fluid"], k=k)])
+    assert ast.unparse(plan.eqplans[0].methods["loop"].fdef).splitlines()[1:] == ["    " + body]
+
+
+def test_a_switch_changed_after_generation_is_refused():
+    eq = Switched("fluid", ["fluid"], k=2.5)
+    plan, _ = _specialised([eq])
+    eq.k = 3.0
+    check_switches(plan)    # another non-zero value: the same code
+    eq.k = 0.0
+    with pytest.raises(SceneError, match="Switched.k is 0.0, but the scene was generated for k = 'non-zero'"):
+        check_switches(plan)
 
 
 def test_pair_loops_must_be_gather_only():

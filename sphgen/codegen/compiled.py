@@ -3,6 +3,7 @@ import numpy as np
 
 from .backend import Backend
 from .build import load_or_build
+from .passes.specialise import check_switches
 from .render import render
 
 
@@ -53,6 +54,7 @@ class CompiledBackend(Backend):
         return out
 
     def bind(self, arrays):
+        check_switches(self.plan)
         self._arrays = arrays
         self._bound_lists = None
         self.module._sphgen_owner = self

@@ -215,6 +215,7 @@ class Plan:
     functions: list = field(default_factory=list)     # FunctionPlans, in emission order
     helpers: list = field(default_factory=list)       # Specialised helpers, callees first
     parameters: dict = field(default_factory=dict)    # module global -> (owner, attribute)
+    switches: list = field(default_factory=list)      # (owner, {switch: what the code assumes})
     log: list = field(default_factory=list)           # (pass name, [notes])
 
     def dtype(self, arr, prop):

@@ -30,10 +30,11 @@ def _const_value(node):
 class _Specialiser(ast.NodeTransformer):
     """Fold switches, rename params, prune constant branches."""
 
-    def __init__(self, constants, param_names, prefix, methods=(), dim=3):
+    def __init__(self, constants, param_names, prefix, methods=(), dim=3, nonzero=()):
         self.dim = dim
         self.methods = set(methods)
         self.constants = constants
+        self.nonzero = set(nonzero)
         self.param_names = param_names
         self.prefix = prefix
         self.globals_used = set()
@@ -97,7 +98,18 @@ class _Specialiser(ast.NodeTransformer):
                 return node
         return node
 
+    def _nonzero_switch(self, node):
+        return (isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) and node.value.id == "self"
+                and node.attr in self.nonzero)
+
     def visit_Compare(self, node):
+        # ``self.k != 0`` of a non-zero switch k is True, ``self.k == 0`` False (k stays a
+        # run-time parameter elsewhere)
+        if len(node.ops) == 1 and isinstance(node.ops[0], (ast.Eq, ast.NotEq)):
+            for a, b in ((node.left, node.comparators[0]), (node.comparators[0], node.left)):
+                if self._nonzero_switch(a) and isinstance(b, ast.Constant) and \
+                        not isinstance(b.value, bool) and b.value == 0:
+                    return ast.copy_location(ast.Constant(isinstance(node.ops[0], ast.NotEq)), node)
         self.generic_visit(node)
         vals = [node.left] + list(node.comparators)
         if all(isinstance(v, ast.Constant) for v in vals):
@@ -341,10 +353,11 @@ def method_source(func):
     return textwrap.dedent("".join(lines)), inspect.getsourcefile(func) or "<unknown>", first
 
 
-def specialise(owner, method, constants, prefix, keep_defaults=False, dim=3, dead=()):
+def specialise(owner, method, constants, prefix, keep_defaults=False, dim=3, dead=(), nonzero=()):
     """Specialise ``owner.method`` into a function named ``<prefix>_<method>``.
 
-    ``constants`` are folded; other numeric attributes become globals ``<prefix>_<name>``.
+    ``constants`` are folded; other numeric attributes become globals ``<prefix>_<name>``;
+    a comparison of an attribute in ``nonzero`` with 0 is folded (it is known not to be 0).
     """
     func_name = method if prefix is None else f"{prefix}_{method}"
     func = getattr(type(owner), method) if not isinstance(owner, types.FunctionType) else owner
@@ -364,7 +377,7 @@ def specialise(owner, method, constants, prefix, keep_defaults=False, dim=3, dea
         fdef.args.defaults = fdef.args.defaults[-len(fdef.args.args):] if fdef.args.args else []
     numeric = {k for k, v in params.items() if isinstance(v, (int, float)) and k not in constants}
     methods = [m for m in dir(type(owner)) if not m.startswith("_") and callable(getattr(type(owner), m))]
-    sp = _Specialiser(constants, numeric, prefix, methods, dim)
+    sp = _Specialiser(constants, numeric, prefix, methods, dim, nonzero)
     fdef = sp.visit(fdef)
     if dead:
         fdef = _DeadStores(set(dead)).visit(fdef)

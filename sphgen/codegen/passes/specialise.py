@@ -18,6 +18,21 @@ def folded_switches(obj):
     return out
 
 
+def nonzero_switches(obj):
+    """The float switches that are not zero: their value stays a run-time parameter, but
+    a test ``self.k != 0`` is folded to True (and ``== 0`` to False), so that a pair loop
+    is not cut by a branch around the only loads of a property, which gcc does not
+    vectorise (a switched-on artificial viscosity or delta-SPH term)."""
+    return {k for k in getattr(obj, "switches", ())
+            if not isinstance(getattr(obj, k), (bool, int)) and getattr(obj, k) != 0}
+
+
+def switch_states(obj):
+    """{switch: value folded, or 'non-zero'}: what the generated code assumes of ``obj``."""
+    nonzero = nonzero_switches(obj)
+    return {k: ("non-zero" if k in nonzero else getattr(obj, k)) for k in getattr(obj, "switches", ())}
+
+
 def _why_empty(ep):
     if ep.dead_stores:
         return "nothing reads what it writes (" + ", ".join(sorted(d[2:] for d in ep.dead_stores)) + ")"
@@ -28,10 +43,10 @@ def _why_empty(ep):
 def specialise_equation(ep, dim):
     """(Re)specialise the methods of one equation, without its dead stores."""
     ep.kept, ep.reason, ep.methods = True, "", {}
-    consts = folded_switches(ep.eq)
+    consts, nonzero = folded_switches(ep.eq), nonzero_switches(ep.eq)
     for m in ep.eq.methods():
         try:
-            sp = specialise_method(ep.eq, m, consts, ep.prefix, dim=dim, dead=ep.dead_stores)
+            sp = specialise_method(ep.eq, m, consts, ep.prefix, dim=dim, dead=ep.dead_stores, nonzero=nonzero)
         except TranslationError as e:
             raise SceneError(f"{ep.name}.{m}: {e}") from None
         if m in PAIR_METHODS and any(w.startswith("s_") for w in sp.writes):
@@ -44,16 +59,29 @@ def specialise_equation(ep, dim):
         ep.kept, ep.reason = False, _why_empty(ep)
 
 
+def check_switches(plan):
+    """Refuse to run a module whose switches have changed since it was generated (a
+    folded value, or a non-zero one that became zero): a new scene is needed."""
+    for owner, states in plan.switches:
+        now = switch_states(owner)
+        for k, was in states.items():
+            if now[k] != was:
+                raise SceneError(f"{type(owner).__name__}.{k} is {getattr(owner, k)!r}, but the scene was "
+                                 f"generated for {k} = {was!r}; build a new Scene after changing a switch")
+
+
 def specialise(plan):
     """Specialise every equation and stage method; an equation left with nothing is dropped."""
     notes = []
+    plan.switches = [(o, switch_states(o)) for o in [ep.eq for ep in plan.eqplans] +
+                     [st.stepper for st in plan.steppers] if getattr(o, "switches", ())]
     for ep in plan.eqplans:
         specialise_equation(ep, plan.dim)
         if not ep.kept:
             notes.append(f"drop {ep.name}: {ep.reason}")
     for st in plan.steppers:
-        consts = folded_switches(st.stepper)
-        specs = {m: specialise_method(st.stepper, m, consts, st.prefix, dim=plan.dim)
+        consts, nonzero = folded_switches(st.stepper), nonzero_switches(st.stepper)
+        specs = {m: specialise_method(st.stepper, m, consts, st.prefix, dim=plan.dim, nonzero=nonzero)
                  for m in st.stepper.stage_methods()}
         st.stages = {m: sp for m, sp in specs.items() if not sp.empty}
     n = sum(len(ep.methods) for ep in plan.eqplans) + sum(len(st.stages) for st in plan.steppers)
