@@ -111,12 +111,13 @@ class FreeSurfaceParticles(Equation):
 
     def loop(self, d_idx, d_rho_s, d_fs_blocked, d_normal, d_h, s_idx, s_m, WIJ, XIJ, RIJ):
         d_rho_s[d_idx] += s_m[s_idx] * WIJ
-        if RIJ > 1e-12 and RIJ < self.radius * d_h[d_idx]:
-            # r_b - r_a = -XIJ
-            c = -(d_normal[3 * d_idx] * XIJ[0] + d_normal[3 * d_idx + 1] * XIJ[1]
-                  + d_normal[3 * d_idx + 2] * XIJ[2]) / RIJ
-            if c > 0.5:
-                d_fs_blocked[d_idx] += 1.0
+        # the cosine of the angle between n_a and r_b - r_a = -XIJ, computed before the
+        # test: a test on plain values is one the pair loop vectorises with
+        c = -(d_normal[3 * d_idx] * XIJ[0] + d_normal[3 * d_idx + 1] * XIJ[1]
+              + d_normal[3 * d_idx + 2] * XIJ[2]) / max(RIJ, 1e-12)
+        reach = self.radius * d_h[d_idx]
+        if RIJ > 1e-12 and RIJ < reach and c > 0.5:
+            d_fs_blocked[d_idx] += 1.0
 
     def post_loop(self, d_idx, d_rho_s, d_fs_blocked, d_normal, d_free_surface):
         nx = d_normal[3 * d_idx]

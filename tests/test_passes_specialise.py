@@ -96,6 +96,25 @@ def test_a_switch_changed_after_generation_is_refused():
         check_switches(plan)
 
 
+class Cone(Equation):
+    def loop(self, d_idx, d_s, s_idx, s_m, RIJ, HIJ):
+        c = RIJ / HIJ
+        if RIJ > 1e-12 and c < 2.0 and (c > 0.5 or -c > 0.5):
+            d_s[d_idx] += 1.0
+        if RIJ > 1e-12 and s_m[s_idx] > 0.0:
+            d_s[d_idx] += 2.0
+
+
+def test_tests_on_plain_values_are_eager_and_loads_keep_their_guard():
+    """``and``/``or`` of comparisons of names and arithmetic become ``&``/``|`` (gcc
+    if-converts those: the free-surface cone test's pair loop vectorises); a test that
+    loads from memory keeps its short circuit, so a guarded load stays guarded."""
+    plan, _ = _specialised([Cone("fluid", ["fluid"])])
+    src = ast.unparse(plan.eqplans[0].methods["loop"].fdef)
+    assert "if (RIJ > 1e-12) & (c < 2.0) & ((c > 0.5) | (-c > 0.5)):" in src
+    assert "if RIJ > 1e-12 and s_m[s_idx] > 0.0:" in src
+
+
 def test_pair_loops_must_be_gather_only():
     with pytest.raises(SceneError, match=r"Scatter\[fluid<-fluid\]\.loop writes s_rho: pair loops"):
         _specialised([Scatter("fluid", ["fluid"])])

@@ -174,6 +174,35 @@ class _DeadStores(ast.NodeTransformer):
         return node if node.body else None
 
 
+_PLAIN = (ast.Name, ast.Constant, ast.BinOp, ast.UnaryOp, ast.Compare, ast.Load,
+          ast.operator, ast.unaryop, ast.cmpop)
+
+
+class _EagerTests(ast.NodeTransformer):
+    """``a < b and c > d`` on plain values (names, constants, arithmetic: nothing that
+    loads from memory or calls) becomes ``(a < b) & (c > d)`` (``or``: ``|``).  Cython
+    writes ``and`` as short-circuit jumps, which gcc does not if-convert, so a pair loop
+    with such a test did not vectorise; evaluating both sides of a plain comparison is
+    safe and costs a few instructions."""
+
+    @classmethod
+    def _plain(cls, node):
+        if isinstance(node, ast.BinOp) and isinstance(node.op, (ast.BitAnd, ast.BitOr)):
+            return cls._plain(node.left) and cls._plain(node.right)     # an inner test made eager
+        return isinstance(node, ast.Compare) and len(node.ops) == 1 and \
+            all(isinstance(n, _PLAIN) for n in ast.walk(node))
+
+    def visit_BoolOp(self, node):
+        self.generic_visit(node)
+        if not all(self._plain(v) for v in node.values):
+            return node
+        op = ast.BitAnd() if isinstance(node.op, ast.And) else ast.BitOr()
+        out = node.values[0]
+        for v in node.values[1:]:
+            out = ast.BinOp(out, op, v)
+        return ast.copy_location(out, node)
+
+
 def _remove_dead_locals(fdef):
     """Drop assignments to local names that nothing reads (after folding), repeatedly."""
     while True:
@@ -385,6 +414,7 @@ def specialise(owner, method, constants, prefix, keep_defaults=False, dim=3, dea
     if not fdef.body:
         fdef.body = [ast.Pass()]
     _remove_dead_locals(fdef)
+    fdef = _EagerTests().visit(fdef)
     _declare_loop_counters(fdef)
     used = _names(ast.Module(body=fdef.body, type_ignores=[]))
     keep = [a for a in fdef.args.args if a.arg in used]
