@@ -50,6 +50,27 @@ def fma_vector(long n):
     for k in range(40):
         s += a[k]
     return s
+
+
+from cython.parallel cimport prange
+cimport openmp
+
+
+def regions(long n, double[::1] data, bint hand_over):
+    """n parallel regions of 2 threads.  Each thread adds 1 to its half of ``data``;
+    with ``hand_over`` the halves swap from one region to the next, so every line a
+    thread writes was last written by the other core (what a stage meets after a pass
+    whose particles moved between cores)."""
+    cdef long r, i, lo, hi, m = data.shape[0]
+    cdef int k, who
+    for r in range(n):
+        for k in prange(2, nogil=True, num_threads=2, schedule='static'):
+            who = (k + r) % 2 if hand_over else k
+            lo = who * (m // 2)
+            hi = lo + m // 2
+            for i in range(lo, hi):
+                data[i] = data[i] + 1.0
+    return data[0]
 '''
 
 
@@ -88,6 +109,29 @@ def triad_gbs(n=20_000_000, repeat=5):
     return 3 * 8 * n / best / 1e9
 
 
+def cross_core_us(n=20_000, nbytes=16_384, repeat=5):
+    """The host's cost of two-thread work, in µs a parallel region (medians of
+    ``repeat``): 'region', each thread touching its own 8 kB; 'hand_over', the halves
+    swapped at every region, so each line comes from the other core.  On this kind of VM
+    both jump by 2-3x for minutes at a time, with the load average at 0: the two vCPUs
+    are then farther apart on the host (docs/performance.md)."""
+    mod = _module()
+    data = np.zeros(nbytes // 8)
+    out = {}
+    for name, hand in (("region", False), ("hand_over", True)):
+        mod.regions(n // 10, data, hand)
+        out[name] = 1e6 * float(np.median([_timed(lambda m: mod.regions(m, data, hand), n) for _ in range(repeat)])) / n
+    return out
+
+
+def host_line():
+    """One line for a benchmark's output: the load and the host's cross-core costs."""
+    import os
+    c = cross_core_us()
+    return (f"host: load average {os.getloadavg()[0]:.2f}; a two-thread region {c['region']:.2f} us, "
+            f"with its 16 kB handed between the cores {c['hand_over']:.2f} us")
+
+
 def roofline_line(info, peak, label=""):
     """One line: pairs per second per core, estimated GFLOP/s per core, % of the peaks."""
     flops, pairs = info.get("estimated_pair_flops_per_step"), info.get("neighbour_pairs_per_step")
@@ -113,3 +157,4 @@ if __name__ == "__main__":
     p = peak_gflops()
     print(f"peak, one core: scalar FMA {p['scalar']:.1f} GFLOP/s, AVX2 FMA {p['avx']:.1f} GFLOP/s; "
           f"numpy triad {triad_gbs():.1f} GB/s")
+    print(host_line())
