@@ -103,6 +103,8 @@ class Cone(Equation):
             d_s[d_idx] += 1.0
         if RIJ > 1e-12 and s_m[s_idx] > 0.0:
             d_s[d_idx] += 2.0
+        if RIJ > 1e-12 and HIJ / RIJ < 3.0:
+            d_s[d_idx] += 3.0
 
 
 def test_tests_on_plain_values_are_eager_and_loads_keep_their_guard():
@@ -113,6 +115,7 @@ def test_tests_on_plain_values_are_eager_and_loads_keep_their_guard():
     src = ast.unparse(plan.eqplans[0].methods["loop"].fdef)
     assert "if (RIJ > 1e-12) & (c < 2.0) & ((c > 0.5) | (-c > 0.5)):" in src
     assert "if RIJ > 1e-12 and s_m[s_idx] > 0.0:" in src
+    assert "if RIJ > 1e-12 and HIJ / RIJ < 3.0:" in src          # nor a division
 
 
 def test_pair_loops_must_be_gather_only():

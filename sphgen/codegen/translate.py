@@ -174,13 +174,15 @@ class _DeadStores(ast.NodeTransformer):
         return node if node.body else None
 
 
+# what a comparison may hold to be evaluated eagerly: no load, call or division (an integer
+# division by zero would trap where the short circuit guarded it)
 _PLAIN = (ast.Name, ast.Constant, ast.BinOp, ast.UnaryOp, ast.Compare, ast.Load,
-          ast.operator, ast.unaryop, ast.cmpop)
+          ast.Add, ast.Sub, ast.Mult, ast.unaryop, ast.cmpop)
 
 
 class _EagerTests(ast.NodeTransformer):
-    """``a < b and c > d`` on plain values (names, constants, arithmetic: nothing that
-    loads from memory or calls) becomes ``(a < b) & (c > d)`` (``or``: ``|``).  Cython
+    """``a < b and c > d`` on plain values (names, constants, +, - and *: nothing that
+    loads from memory, calls or divides) becomes ``(a < b) & (c > d)`` (``or``: ``|``).  Cython
     writes ``and`` as short-circuit jumps, which gcc does not if-convert, so a pair loop
     with such a test did not vectorise; evaluating both sides of a plain comparison is
     safe and costs a few instructions."""
