@@ -118,6 +118,31 @@ def test_tests_on_plain_values_are_eager_and_loads_keep_their_guard():
     assert "if RIJ > 1e-12 and HIJ / RIJ < 3.0:" in src          # nor a division
 
 
+class Moments(Equation):
+    def loop(self, d_idx, d_s, d_lmat, s_idx, XIJ, DWIJ):
+        for i in range(3):
+            for j in range(3):
+                d_lmat[9 * d_idx + 3 * i + j] -= XIJ[i] * DWIJ[j]
+        for k in range(3):
+            d_s[d_idx] += XIJ[k]
+        d_s[d_idx] += k
+
+
+def test_constant_loops_are_unrolled_and_the_components_past_the_dimension_fold():
+    """In 2D the 3 x 3 moment keeps 4 of its 9 terms; a loop whose counter is read after it
+    stays a loop."""
+    pa = lattice_cloud(nx=3, dim=2)
+    pa.add_property("s")
+    pa.add_property("lmat", stride=9)
+    plan = new_plan([pa], [Moments("fluid", ["fluid"])], None, QuinticSpline(2), 2)
+    passes.specialise(plan)
+    src = ast.unparse(plan.eqplans[0].methods["loop"].fdef)
+    terms = [line.strip() for line in src.splitlines() if "d_lmat" in line and "+=" not in line][1:]
+    assert terms == ["d_lmat[9 * d_idx] -= XIJ[0] * DWIJ[0]", "d_lmat[9 * d_idx + 1] -= XIJ[0] * DWIJ[1]",
+                     "d_lmat[9 * d_idx + 3] -= XIJ[1] * DWIJ[0]", "d_lmat[9 * d_idx + 3 + 1] -= XIJ[1] * DWIJ[1]"]
+    assert "for k in range(3):" in src and "for i in" not in src
+
+
 def test_pair_loops_must_be_gather_only():
     with pytest.raises(SceneError, match=r"Scatter\[fluid<-fluid\]\.loop writes s_rho: pair loops"):
         _specialised([Scatter("fluid", ["fluid"])])

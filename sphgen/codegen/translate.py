@@ -58,6 +58,9 @@ class _Specialiser(ast.NodeTransformer):
 
     def visit_Subscript(self, node):
         self.generic_visit(node)
+        if isinstance(node.slice, ast.Constant) and isinstance(node.slice.value, float) and \
+                node.slice.value.is_integer():      # an index folded through ``0 * x`` (0.0)
+            node.slice = ast.copy_location(ast.Constant(int(node.slice.value)), node.slice)
         # vector pair symbols have zero components beyond the scene's dimension
         if isinstance(node.value, ast.Name) and pair_symbols.is_vector(node.value.id) and \
                 isinstance(node.ctx, ast.Load) and isinstance(node.slice, ast.Constant) and \
@@ -172,6 +175,52 @@ class _DeadStores(ast.NodeTransformer):
     def visit_For(self, node):
         self.generic_visit(node)
         return node if node.body else None
+
+
+class _Unroll(ast.NodeTransformer):
+    """``for i in range(n)`` with a constant ``n`` (after switch folding, e.g.
+    ``range(self.dim)``) becomes ``n`` copies of its body with ``i`` a literal, when the
+    copies stay small and ``i`` is not assigned, nor read after the loop, and there is no
+    ``break``/``continue``/``else``.  The components of vector symbols past the dimension
+    are then literal indices that fold to 0 (in 2D, ``XIJ[i] * DWIJ[j]`` over 3 x 3 keeps 4
+    of its 9 terms); gcc unrolls such loops too, but may not fold ``0.0 * x``."""
+
+    MAX_STATEMENTS = 96      # statements a loop may become
+
+    def __init__(self, fdef):
+        # names read outside every loop that binds them: their loops are kept
+        inside = {id(x) for f in ast.walk(fdef) if isinstance(f, ast.For) and isinstance(f.target, ast.Name)
+                  for st in f.body for x in ast.walk(st) if isinstance(x, ast.Name) and x.id == f.target.id}
+        self.read_outside = {n.id for n in ast.walk(fdef) if isinstance(n, ast.Name)
+                             and isinstance(n.ctx, ast.Load) and id(n) not in inside}
+
+    def visit_For(self, node):
+        self.generic_visit(node)
+        if not (isinstance(node.target, ast.Name) and isinstance(node.iter, ast.Call)
+                and getattr(node.iter.func, "id", "") == "range" and not node.orelse
+                and len(node.iter.args) == 1 and isinstance(node.iter.args[0], ast.Constant)
+                and isinstance(node.iter.args[0].value, int)):
+            return node
+        n, name = node.iter.args[0].value, node.target.id
+        inner = [x for st in node.body for x in ast.walk(st)]
+        if any(isinstance(x, (ast.Break, ast.Continue, ast.For, ast.While)) for x in inner) or \
+                any(isinstance(x, ast.Name) and x.id == name and not isinstance(x.ctx, ast.Load) for x in inner):
+            return node
+        if name in self.read_outside or n * sum(isinstance(x, ast.stmt) for x in inner) > self.MAX_STATEMENTS:
+            return node            # read after the loop, or too large
+        out = []
+        for k in range(n):
+            for st in node.body:
+                copy_ = copy.deepcopy(st)
+                for x in ast.walk(copy_):
+                    for field, value in ast.iter_fields(x):
+                        if isinstance(value, ast.Name) and value.id == name:
+                            setattr(x, field, ast.copy_location(ast.Constant(k), value))
+                        elif isinstance(value, list):
+                            value[:] = [ast.copy_location(ast.Constant(k), v) if isinstance(v, ast.Name)
+                                        and v.id == name else v for v in value]
+                out.append(copy_)
+        return out or None
 
 
 # what a comparison may hold to be evaluated eagerly: no load, call or division (an integer
@@ -410,6 +459,7 @@ def specialise(owner, method, constants, prefix, keep_defaults=False, dim=3, dea
     methods = [m for m in dir(type(owner)) if not m.startswith("_") and callable(getattr(type(owner), m))]
     sp = _Specialiser(constants, numeric, prefix, methods, dim, nonzero)
     fdef = sp.visit(fdef)
+    fdef = sp.visit(_Unroll(fdef).visit(fdef))     # then fold what the literal indices made constant
     if dead:
         fdef = _DeadStores(set(dead)).visit(fdef)
         fdef = sp.visit(fdef)
