@@ -269,3 +269,40 @@ def test_two_scenes_sharing_one_module_keep_their_own_neighbour_rows():
         np.testing.assert_array_equal(together[2 * k], alone[0][k])
         np.testing.assert_array_equal(together[2 * k + 1], alone[1][k])
     assert sa.nnps.n_builds < sa.nnps.n_updates         # the rows were cut from kept lists
+
+
+def test_rows_cut_in_place_are_not_handed_to_the_module_again():
+    """While the skin lists stand, each update cuts the rows inside the buffers the module
+    already holds: binding then costs no look at them (no rows_of, no module call); a
+    rebuild, a sort or new thread parts hands them over again, and the densities stay
+    those of a scene without a skin (to round-off: the two sorts order differently)."""
+    def run(skin, watch=None):
+        pa = lattice_cloud(nx=10, seed=3, gid=np.arange(100.0))
+        sc = Scene([pa], [SummationDensity("fluid", ["fluid"])], dim=2, domain=periodic_box(2),
+                   outputs={"fluid": ["rho"]}, skin=skin, threads=2)
+        if watch is not None:
+            rows_of = sc.nnps.rows_of
+            sc.nnps.rows_of = lambda *args: watch.append(sc.nnps.n_builds) or rows_of(*args)
+        out = []
+        for k in range(8):
+            pa.x[:] += 0.0005 * pa.u
+            pa.y[:] += 0.0005 * pa.v
+            if k == 5:
+                sc.sort()
+            sc.update_nnps()
+            sc.compute(0, 0.0, 0.001)
+            out.append(pa.rho[np.argsort(pa.gid)].copy())
+        return sc, out
+
+    calls = []
+    sa, with_skin = run(0.3, calls)
+    _, without = run(0.0)
+    for a, b in zip(with_skin, without):
+        np.testing.assert_allclose(a, b, rtol=1e-13)
+    assert sa.nnps.n_builds == 3 + 2                 # construction (build, sort: two), the sort
+    # the sort hands over new rows; it and the first update are followed by a re-plan for
+    # the parts the module cut; the five other updates cut in place and bind nothing
+    assert calls == [3, 5, 5], calls
+    sa.set_threads(1)                                # new parts: looked at again
+    sa.update_nnps()
+    assert len(calls) == 4

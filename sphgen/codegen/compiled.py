@@ -28,6 +28,7 @@ class CompiledBackend(Backend):
         self._stages = {k: getattr(self.module, v) for k, v in self.rendered.stage_entries.items()}
         self._arrays, self._threads = None, 1
         self._bound_lists = None      # the lists the module holds (taken again only if they change)
+        self._bound_rows = None       # the search's row_version when they were bound
         self._reference_rows = {}     # key -> row views of a frozen list
         self._parts = None            # {array: the module's thread parts}, taken at each rebind
 
@@ -57,6 +58,7 @@ class CompiledBackend(Backend):
         check_switches(self.plan)
         self._arrays = arrays
         self._bound_lists = None
+        self._bound_rows = None
         self.module._sphgen_owner = self
         self.module.bind_arrays({pa.name: (pa.n, {**pa.data, **pa.constants}) for pa in arrays})
         self.module.set_parameters({g: float(getattr(o, a)) for g, (o, a) in self.rendered.parameters.items()})
@@ -65,6 +67,8 @@ class CompiledBackend(Backend):
     def bind_neighbours(self):
         if getattr(self.module, "_sphgen_owner", None) is not self and self._arrays is not None:
             return self._claim()     # binds everything, these neighbour lists included
+        if self._bound_rows is not None and self.nnps.rows_unchanged(self._bound_rows, self._parts):
+            return                   # cut anew inside the very arrays the module holds
         lists = {}
         exact = [(key, dest, src) for key, (dest, src, reference) in self.rendered.neighbour_lists.items()
                  if not reference]
@@ -84,6 +88,7 @@ class CompiledBackend(Backend):
             self.module.bind_neighbours(lists)    # else the module holds these very arrays
             self._bound_lists = lists
             self._parts = self._thread_parts()    # the module cut them anew
+        self._bound_rows = self.nnps.row_version
 
     def run_pass(self, npass, t, dt):
         self._claim()

@@ -183,6 +183,7 @@ class NeighbourSearch:
         self._by_name = dict(zip(names, arrays))
         self._cache = {}
         self._row_cache = {}     # (dest, src) -> (starts, ends, nbrs, pairs) since the update
+        self.row_version = 0     # changes whenever rows_of may hand out other arrays
         self._row_buffers = {}   # (dest, src) -> buffers of the cut rows, kept across updates
         self._plan = None        # the cut of every update while the skin lists stand
         self._frozen = {}
@@ -230,6 +231,7 @@ class NeighbourSearch:
                 kept = self._within_skin()
                 if kept:
                     self._row_cache = {}
+                    self.row_version += 1
                     self._points = {}
             if kept:
                 self._cache = {}
@@ -336,6 +338,7 @@ class NeighbourSearch:
             self._sizes[pa.name] = pa.n
         self._cache = {}
         self._row_cache = {}
+        self.row_version += 1
         self._points = {}
         self._skin_lists = {}
         self._plan = None
@@ -470,6 +473,7 @@ class NeighbourSearch:
         keys = [(self._array(d), self._array(s)) for d, s in pairs]
         todo = [(d, s) for d, s in keys if (d.name, s.name) not in self._row_cache]
         if todo:
+            self.row_version += 1
             if self.skin_distance <= 0:
                 for d, s in todo:
                     off, nbrs = self.neighbours(d, s)
@@ -488,6 +492,14 @@ class NeighbourSearch:
         elif self._plan is not None and parts is not None and not _same_parts(parts, self._plan["parts"]):
             self._plan_refresh(self._plan["cut"], parts)   # the module cut its parts anew
         return [self._row_cache[(d.name, s.name)] for d, s in keys]
+
+    def rows_unchanged(self, version, parts):
+        """True if every row :meth:`rows_of` handed out when :attr:`row_version` was
+        ``version`` (and the frozen lists) are still the arrays it would hand out now, cut
+        anew in place by the update, along the thread ``parts`` given then: a backend that
+        holds those arrays need not look at them again."""
+        plan = self._plan
+        return version == self.row_version and plan is not None and plan["parts"] is parts
 
     def _plan_refresh(self, cut, parts):
         """Keep what :func:`cut_rows` needs to check the skin and cut the rows of ``cut``
@@ -564,6 +576,7 @@ class NeighbourSearch:
         d, s = self._array(dest), self._array(src)
         offsets, nbrs = self.neighbours(d, s)
         self._frozen[(d.name, s.name)] = (offsets.copy(), nbrs.copy())
+        self.row_version += 1
 
     def reference_neighbours(self, dest, src):
         """``(offsets, nbrs)`` of the list frozen by :meth:`freeze`."""
