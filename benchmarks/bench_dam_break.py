@@ -29,7 +29,7 @@ import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from pysph_baseline import find_pysph_python  # noqa: E402
-from roofline import median_run_line, peak_gflops  # noqa: E402
+from roofline import host_line, median_run_line, peak_gflops  # noqa: E402
 
 SPHGEN = os.path.join(os.path.dirname(sys.executable), "sphgen")
 
@@ -95,6 +95,7 @@ def main():
     ap.add_argument("--no-pysph", action="store_true")
     a = ap.parse_args()
     print(f"load average before: {os.getloadavg()[0]:.2f}")
+    print(host_line())
     py = None if a.no_pysph else find_pysph_python()
     work = tempfile.mkdtemp(prefix="sphgen_db_")
     for config in CONFIGS:
@@ -138,7 +139,7 @@ def main():
                 print(f"PySPH / {config}, {threads} thread(s): {p[0] / s[0]:.2f}x per particle-step, "
                       f"{p[1] / s[1]:.2f}x per fluid particle-step")
 
-
+    print(host_line())
     print(f"load average after: {os.getloadavg()[0]:.2f}")
 
 

@@ -24,7 +24,7 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from pysph_baseline import _busy_cpu_seconds, find_pysph_python, run_pysph  # noqa: E402
-from roofline import peak_gflops, roofline_line  # noqa: E402
+from roofline import host_line, peak_gflops, roofline_line  # noqa: E402
 
 # sphgen's scheme -> PySPH 1.0b2's closest Taylor-Green scheme (docs/performance.md)
 PYSPH_CLOSEST = {"edac": "edac", "ctvf": "gtvf", "gtvf": "gtvf"}
@@ -80,7 +80,7 @@ def main(argv=None):
     work = tempfile.mkdtemp(prefix="sphgen_bench_")
     pysph_scheme = PYSPH_CLOSEST[o.scheme]
     res = {"scheme": o.scheme, "pysph_scheme": pysph_scheme, "nx": o.nx, "tf": o.tf, "repeat": o.repeat,
-           "load_start": os.getloadavg()[0]}
+           "load_start": os.getloadavg()[0], "host_start": host_line()}
 
     cold = run_sphgen(o.nx, o.tf, 2, work, cache=os.path.join(work, "cache"), scheme=o.scheme)
     res["sphgen_compile_s"] = cold["compile_time"]
@@ -110,6 +110,7 @@ def main(argv=None):
                              "other_cpu_s": [round(r["other_cpu_s"] or 0, 2) for r in ok]}
         res[f"ratio_{t}"] = res[f"pysph_{t}"]["us_per_particle_step"] / res[f"sphgen_{t}"]["us_per_particle_step"]
     res["load_end"] = os.getloadavg()[0]
+    res["host_end"] = host_line()
     peak = peak_gflops()
     res["roofline"] = [roofline_line(sorted(ours[t], key=lambda r: r["wall_time"])[len(ours[t]) // 2], peak,
                                      f"sphgen {t} thread(s)") for t in (1, 2)]
@@ -139,6 +140,8 @@ def main(argv=None):
     for line in res["roofline"]:
         print(line)
     print(f"load average: {res['load_start']:.2f} at start, {res['load_end']:.2f} at end")
+    print(f"at start, {res['host_start']}")
+    print(f"at end, {res['host_end']}")
     if o.json:
         with open(o.json, "w") as f:
             json.dump(res, f, indent=1)

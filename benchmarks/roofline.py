@@ -56,6 +56,31 @@ from cython.parallel cimport prange
 cimport openmp
 
 
+cdef double _lanes(long n) noexcept nogil:
+    """fma_vector's loop, callable from a parallel region."""
+    cdef double a[40]
+    cdef double m = 0.999999, c = 1e-7, s = 0.0
+    cdef long i
+    cdef int k
+    for k in range(40):
+        a[k] = 1.0 + 0.01 * k
+    for i in range(n):
+        for k in range(40):
+            a[k] = a[k] * m + c
+    for k in range(40):
+        s += a[k]
+    return s
+
+
+def fma_cores(long n, int threads):
+    """fma_vector's n iterations on each of ``threads`` threads at once (one region)."""
+    cdef int k
+    cdef double s = 0.0
+    for k in prange(threads, nogil=True, num_threads=threads, schedule='static'):
+        s += _lanes(n)
+    return s
+
+
 def regions(long n, double[::1] data, bint hand_over):
     """n parallel regions of 2 threads.  Each thread adds 1 to its half of ``data``;
     with ``hand_over`` the halves swap from one region to the next, so every line a
@@ -124,11 +149,27 @@ def cross_core_us(n=20_000, nbytes=16_384, repeat=5):
     return out
 
 
+def two_core_fma(n=25_000_000, repeat=5):
+    """How many times one core's FMA rate the host's two cores give together: the AVX2
+    chains of ``fma_vector`` on one thread, then the same on each of two threads at once,
+    alternated ``repeat`` times (medians).  No memory, no synchronisation inside: the most
+    any program can gain from a second core of this VM at that moment (1.8-2.0 on
+    2026-11-28, docs/performance.md)."""
+    mod = _module()
+    times = {1: [], 2: []}
+    for _ in range(repeat):
+        for k in (1, 2):
+            times[k].append(_timed(lambda m: mod.fma_cores(m, k), n))
+    return 2.0 * float(np.median(times[1])) / float(np.median(times[2]))
+
+
 def host_line():
-    """One line for a benchmark's output: the load and the host's cross-core costs."""
+    """One line for a benchmark's output: the load, the two cores' FMA ceiling and the
+    host's cross-core costs."""
     import os
     c = cross_core_us()
-    return (f"host: load average {os.getloadavg()[0]:.2f}; a two-thread region {c['region']:.2f} us, "
+    return (f"host: load average {os.getloadavg()[0]:.2f}; two cores give {two_core_fma():.2f}x one "
+            f"core's FMA rate; a two-thread region {c['region']:.2f} us, "
             f"with its 16 kB handed between the cores {c['hand_over']:.2f} us")
 
 
