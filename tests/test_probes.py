@@ -222,3 +222,24 @@ def test_count_neighbours_is_brute_force(dim):
     brute = (np.linalg.norm(X[:, None, :] - X[None, :, :], axis=2) < r).sum(axis=1)
     assert np.array_equal(probes.count_neighbours(pts, r), brute)
     assert probes.count_neighbours(tuple(np.empty(0) for _ in range(dim)), r).size == 0
+
+
+def test_count_neighbours_reuses_its_search_with_fresh_positions():
+    """Calls with the same count and radius reuse the last search: each still counts the
+    positions it is given (moved, spread, then a different count), and a non-finite
+    position is refused without spoiling the next call."""
+    rng = np.random.default_rng(9)
+    r = 0.15
+
+    def brute(pts):
+        X = np.column_stack(pts)
+        return (np.linalg.norm(X[:, None, :] - X[None, :, :], axis=2) < r).sum(axis=1)
+
+    for n, spread in ((200, 1.0), (200, 0.5), (200, 3.0), (150, 1.0)):
+        pts = tuple(rng.uniform(0, spread, n) for _ in range(2))
+        assert np.array_equal(probes.count_neighbours(pts, r), brute(pts))
+    bad = (pts[0].copy(), pts[1])
+    bad[0][7] = np.nan
+    with pytest.raises(ValueError, match="non-finite"):
+        probes.count_neighbours(bad, r)
+    assert np.array_equal(probes.count_neighbours(pts, r), brute(pts))

@@ -53,17 +53,31 @@ def kernel_values(kernel, r, h):
     return np.vectorize(kernel.w, otypes=[float])(r, h)
 
 
+_COUNTER = {}    # (dim, radius, n) -> (ParticleArray, NeighbourSearch) of the last count
+
+
 def count_neighbours(positions, radius):
     """Number of particles (itself included) closer than radius to each particle (the
-    compiled cell list of :mod:`sphgen.nnps`: a probe called every few steps of a run)."""
+    compiled cell list of :mod:`sphgen.nnps`: a probe called every few steps of a run, so
+    the search of the last call is kept and reused for the same count and radius)."""
     from sphgen.nnps import NeighbourSearch
     from sphgen.particles import ParticleArray
     coords = [np.array(c, dtype=float).ravel() for c in positions]
     n = coords[0].size
     if n == 0:
         return np.zeros(0, dtype=np.int64)
-    pa = ParticleArray("probe", h=np.full(n, float(radius)), **dict(zip("xyz", coords)))
-    return NeighbourSearch([pa], len(coords), 1.0, sort=False).neighbour_counts("probe", "probe").astype(np.int64)
+    key = (len(coords), float(radius), n)
+    held = _COUNTER.get(key)
+    if held is None:
+        pa = ParticleArray("probe", h=np.full(n, float(radius)), **dict(zip("xyz", coords)))
+        held = (pa, NeighbourSearch([pa], len(coords), 1.0, sort=False))
+        _COUNTER.clear()
+        _COUNTER[key] = held
+    else:
+        for axis, c in zip("xyz", coords):
+            held[0].get(axis)[:] = c
+        held[1].update()
+    return held[1].neighbour_counts("probe", "probe").astype(np.int64)
 
 
 # ------------------------------------------------------------------ interpolation
