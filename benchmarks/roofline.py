@@ -36,26 +36,6 @@ def fma_scalar(long n):
     return a0 + a1 + a2 + a3 + a4 + a5 + a6 + a7 + a8 + a9
 
 
-def fma_vector(long n):
-    """2 flops x 40 lanes (10 chains of 4 doubles) per iteration."""
-    cdef double a[40]
-    cdef double m = 0.999999, c = 1e-7, s = 0.0
-    cdef long i
-    cdef int k
-    for k in range(40):
-        a[k] = 1.0 + 0.01 * k
-    for i in range(n):
-        for k in range(40):
-            a[k] = a[k] * m + c
-    for k in range(40):
-        s += a[k]
-    return s
-
-
-from cython.parallel cimport prange
-cimport openmp
-
-
 cdef double _lanes(long n) noexcept nogil:
     """fma_vector's loop, callable from a parallel region."""
     cdef double a[40]
@@ -70,6 +50,15 @@ cdef double _lanes(long n) noexcept nogil:
     for k in range(40):
         s += a[k]
     return s
+
+
+def fma_vector(long n):
+    """2 flops x 40 lanes (10 chains of 4 doubles) per iteration."""
+    return _lanes(n)
+
+
+from cython.parallel cimport prange
+cimport openmp
 
 
 def fma_cores(long n, int threads):
