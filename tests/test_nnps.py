@@ -495,12 +495,12 @@ def test_skin_gives_the_exact_lists_and_rebuilds_only_when_needed(dim, periodic,
 @pytest.mark.parametrize("periodic", [False, True])
 def test_an_update_checks_the_skin_and_cuts_the_rows_in_one_call(periodic, monkeypatch):
     """Once an update's lists have been cut, each following update (while the skin lists
-    stand) checks the skin and cuts the same lists in one compiled call, no separate skin
-    check; the rows equal a fresh build through motion, a rebuild, a replaced coordinate
-    array (the plan is dropped, never used on stale memory), and a non-finite position is
-    still named by the rebuild."""
+    stand) checks the skin and cuts the same lists in one compiled call of a CutPlan read
+    once (no cut_rows, no separate skin check); the rows equal a fresh build through
+    motion, a rebuild, a replaced coordinate array (the plan is dropped, never used on
+    stale memory), and a non-finite position is still named by the rebuild."""
     import sphgen.nnps as nnps_mod
-    calls = {"cut": 0, "motion": 0}
+    calls = {"cut": 0, "motion": 0, "plans": 0, "runs": 0}
     real_cut, real_motion = nnps_mod.cut_rows, nnps_mod.largest_motion
 
     def cut(*args, **kw):
@@ -510,8 +510,17 @@ def test_an_update_checks_the_skin_and_cuts_the_rows_in_one_call(periodic, monke
     def motion(*args, **kw):
         calls["motion"] += 1
         return real_motion(*args, **kw)
+
+    class CountedPlan(nnps_mod.CutPlan):
+        def __init__(self, *args):
+            calls["plans"] += 1
+
+        def run(self, *args):
+            calls["runs"] += 1
+            return super().run(*args)
     monkeypatch.setattr(nnps_mod, "cut_rows", cut)
     monkeypatch.setattr(nnps_mod, "largest_motion", motion)
+    monkeypatch.setattr(nnps_mod, "CutPlan", CountedPlan)
     rng = np.random.default_rng(31)
     dim, h = 2, 0.04
     dom = domain_for((periodic,) * dim)
@@ -529,15 +538,16 @@ def test_an_update_checks_the_skin_and_cuts_the_rows_in_one_call(periodic, monke
             assert pairs == fresh.pair_totals()[(d, s)]
     nn.update()
     check()                                  # cut the usual way: the plan is made
+    assert calls["plans"] == 1
     builds, planned = nn.n_builds, 0
     for step in range(12):
         for group in (skinned, exact):
             _drift(group[0], dim, step, 2e-5)
-        calls.update(cut=0, motion=0)
+        calls.update(cut=0, motion=0, runs=0)
         nn.update()
-        assert nn.n_builds == builds and calls == {"cut": 1, "motion": 0}
+        assert nn.n_builds == builds and calls == {"cut": 0, "motion": 0, "plans": 1, "runs": 1}
         check()
-        assert calls["cut"] == 1             # nothing left to cut
+        assert calls["cut"] == 0 and calls["runs"] == 1    # nothing left to cut
         planned += 1
     assert planned == 12
     for group in (skinned, exact):           # beyond the skin: a rebuild, then the usual cut

@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from ._cell_list import (GridSpec, RowBuffers, bin_particles, build_csr, cut_rows, gather_points,
+from ._cell_list import (CutPlan, GridSpec, RowBuffers, bin_particles, build_csr, cut_rows, gather_points,
                           largest_motion, refine_csr, remap_csr, scan, wrap_periodic)
 
 __all__ = ["Domain", "NeighbourSearch", "NotFrozenError"]
@@ -252,8 +252,7 @@ class NeighbourSearch:
                 return None
         if not self._wrap():
             return False
-        pairs = cut_rows(self.grid, plan["jobs"], plan["gathers"], self.radius_scale, plan["motions"],
-                         self.skin_distance, self._periodic_lengths)
+        pairs = plan["cutter"].run(self.skin_distance)
         if pairs is None:
             return False
         self._points = dict(plan["records"])
@@ -521,8 +520,10 @@ class NeighbourSearch:
         motions = [(self._coords(pa), ref[:-1], pa.get("h"), ref[-1], parts.get(pa.name))
                    for pa in self.arrays for ref in [self._built_at[pa.name]] if pa.n]
         arrays = [(pa, pa.n, [(p, pa.get(p)) for p in _AXES[:self.dim] + ("h",)]) for pa in self.arrays]
-        self._plan = {"jobs": jobs, "gathers": gathers, "motions": motions, "records": records,
-                      "kept": kept, "arrays": arrays, "parts": parts, "cut": cut}
+        # the arrays' memory read once for every update until the rebuild
+        cutter = CutPlan(self.grid, jobs, gathers, self.radius_scale, motions, self._periodic_lengths)
+        self._plan = {"cutter": cutter, "records": records, "kept": kept, "arrays": arrays, "parts": parts,
+                      "cut": cut}
 
     def _cut_rows(self, todo, parts):
         """{(dest, src): rows} cut in place from the skin lists of ``todo`` ((d, s, lists)

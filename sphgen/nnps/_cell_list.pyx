@@ -1048,6 +1048,8 @@ ctypedef struct CutJob:
     int* ends
     Py_ssize_t nd
     const long* parts    # thread k cuts rows parts[k] .. parts[k+1]-1 (NULL: equal parts)
+    const long* given    # the parts as given, and their length (resolved for each run)
+    Py_ssize_t ngiven
 
 
 ctypedef struct GatherJob:
@@ -1056,6 +1058,8 @@ ctypedef struct GatherJob:
     double* out
     Py_ssize_t n
     const long* parts
+    const long* given
+    Py_ssize_t ngiven
 
 
 ctypedef struct MotionJob:
@@ -1065,6 +1069,8 @@ ctypedef struct MotionJob:
     const double* h_ref
     Py_ssize_t n
     const long* parts
+    const long* given
+    Py_ssize_t ngiven
 
 
 cdef inline Py_ssize_t _cut(const long* parts, Py_ssize_t n, int k, int nt) noexcept nogil:
@@ -1091,15 +1097,22 @@ cdef Py_ssize_t _cut_part(const Grid* g, bint open_box, CutJob* job, Py_ssize_t 
     return total
 
 
-cdef const long* _parts_ptr(object parts, Py_ssize_t n, int nt) except? NULL:
-    """The int64 thread parts of n items if they cut all of them into nt, else NULL."""
+cdef const long* _given_parts(object parts, Py_ssize_t* length) except? NULL:
+    """The int64 thread parts as given (NULL for None), their length in ``length``."""
     cdef const long[::1] v
+    length[0] = 0
     if parts is None:
         return NULL
     v = parts
-    if v.shape[0] != nt + 1 or v[0] != 0 or v[nt] != n:
+    length[0] = v.shape[0]
+    return &v[0] if v.shape[0] else NULL
+
+
+cdef inline const long* _parts_for(const long* given, Py_ssize_t ngiven, Py_ssize_t n, int nt) noexcept nogil:
+    """The given parts of n items if they cut all of them into nt, else NULL (equal counts)."""
+    if given == NULL or ngiven != nt + 1 or given[0] != 0 or given[nt] != n:
         return NULL
-    return &v[0]
+    return given
 
 
 def cut_rows(GridSpec grid, list jobs, list gathers, double radius_scale, list motions=None,
@@ -1126,122 +1139,166 @@ def cut_rows(GridSpec grid, list jobs, list gathers, double radius_scale, list m
     nothing, if some pair can have (or a value is not finite): the lists must be rebuilt.
     The skin check of an update and its cut are then one call (the skin check alone was
     a Python loop and a parallel region per array)."""
-    cdef const Grid* g = &grid.c
-    cdef int nt = max(1, min(sphgen_max_threads(), 64))
-    cdef Py_ssize_t nj = len(jobs), ng = len(gathers), j, i, lo, hi, cnt
-    cdef Py_ssize_t nm = 0 if motions is None else len(motions)
-    cdef int a, k
-    cdef double kh, m2 = 0.0, mh = 0.0
+    return CutPlan(grid, jobs, gathers, radius_scale, motions, lengths).run(skin_distance)
+
+
+cdef class CutPlan:
+    """The arguments of :func:`cut_rows` read once, :meth:`run` as often as wanted: an update
+    of the skin lists cuts the same lists of the same arrays until the next rebuild, and
+    reading some fifty arrays' memory anew at each call cost more than the small loops
+    they feed (the records, the skin check, the wall lists).  It keeps the arrays alive;
+    the caller must drop it when an array is replaced or resized (NeighbourSearch does)."""
+    cdef GridSpec grid
+    cdef CutJob* cj
+    cdef GatherJob* gj
+    cdef MotionJob* mj
+    cdef Py_ssize_t nj, ng, nm
+    cdef double radius_scale
     cdef double L[3]
-    cdef bint open_box = g.dim >= 2 and not (g.periodic[0] or g.periodic[1] or g.periodic[2])
-    cdef CutJob* cj = <CutJob*>malloc((nj + 1) * sizeof(CutJob))
-    cdef GatherJob* gj = <GatherJob*>malloc((ng + 1) * sizeof(GatherJob))
-    cdef MotionJob* mj = <MotionJob*>malloc((nm + 1) * sizeof(MotionJob))
-    cdef Py_ssize_t* found = <Py_ssize_t*>malloc((nj * nt + 1) * sizeof(Py_ssize_t))
-    # where the unclaimed rows of part k of list j start (one cache line each)
-    cdef long* claims = <long*>malloc((8 * nj * nt + 1) * sizeof(long))
-    cdef int o, owner
-    # per thread: largest |dx|^2 and |dh| of its parts (8 doubles apart: no shared line)
-    cdef double* moved = <double*>malloc((8 * nt + 2) * sizeof(double))
-    cdef int[::1] off, nbrs, out, ends
-    cdef double[::1] h, h_ref
-    cdef double[:, ::1] pts
-    keep = []             # the memoryviews behind the pointers, alive through the call
-    try:
-        if cj == NULL or gj == NULL or mj == NULL or found == NULL or moved == NULL or claims == NULL:
+    cdef list keep             # the argument tuples: the arrays behind the pointers
+
+    def __cinit__(self, GridSpec grid, list jobs, list gathers, double radius_scale, list motions=None,
+                  lengths=None):
+        cdef const Grid* g = &grid.c
+        cdef Py_ssize_t j
+        cdef int a
+        cdef int[::1] off, nbrs, out, ends
+        cdef double[::1] h, h_ref
+        cdef double[:, ::1] pts
+        self.grid = grid
+        self.radius_scale = radius_scale
+        self.nj, self.ng = len(jobs), len(gathers)
+        self.nm = 0 if motions is None else len(motions)
+        self.keep = []
+        self.cj = <CutJob*>malloc((self.nj + 1) * sizeof(CutJob))
+        self.gj = <GatherJob*>malloc((self.ng + 1) * sizeof(GatherJob))
+        self.mj = <MotionJob*>malloc((self.nm + 1) * sizeof(MotionJob))
+        if self.cj == NULL or self.gj == NULL or self.mj == NULL:
             raise MemoryError("cut_rows")
         for a in range(3):
-            L[a] = float(lengths[a]) if lengths is not None and a < len(lengths) else 0.0
-        for j in range(nm):
+            self.L[a] = float(lengths[a]) if lengths is not None and a < len(lengths) else 0.0
+        for j in range(self.nm):
             coords, refs, h, h_ref, parts = motions[j]
-            mj[j].n = h.shape[0]
-            if h_ref.shape[0] != mj[j].n or len(coords) < g.dim or len(refs) < g.dim:
+            self.mj[j].n = h.shape[0]
+            if h_ref.shape[0] != self.mj[j].n or len(coords) < g.dim or len(refs) < g.dim:
                 raise ValueError("cut_rows: a motion's arrays do not match")
             for a in range(3):
-                mj[j].x[a] = _coord_ptr(coords[a], mj[j].n) if a < g.dim else NULL
-                mj[j].r[a] = _coord_ptr(refs[a], mj[j].n) if a < g.dim else NULL
-            mj[j].h = &h[0] if mj[j].n else NULL
-            mj[j].h_ref = &h_ref[0] if mj[j].n else NULL
-            mj[j].parts = _parts_ptr(parts, mj[j].n, nt)
-            keep.append((h, h_ref, parts))
-        for j in range(ng):
+                self.mj[j].x[a] = _coord_ptr(coords[a], self.mj[j].n) if a < g.dim else NULL
+                self.mj[j].r[a] = _coord_ptr(refs[a], self.mj[j].n) if a < g.dim else NULL
+            self.mj[j].h = &h[0] if self.mj[j].n else NULL
+            self.mj[j].h_ref = &h_ref[0] if self.mj[j].n else NULL
+            self.mj[j].given = _given_parts(parts, &self.mj[j].ngiven)
+            self.keep.append(motions[j])
+        for j in range(self.ng):
             coords, h, pts, parts = gathers[j]
             if pts.shape[0] < h.shape[0] or pts.shape[1] != 4:
                 raise ValueError("cut_rows: a source's records need (n, 4) entries")
-            gj[j].n = h.shape[0]
+            self.gj[j].n = h.shape[0]
             for a in range(3):
-                gj[j].x[a] = _coord_ptr(coords[a], gj[j].n) if a < len(coords) else NULL
-            gj[j].h = &h[0] if gj[j].n else NULL
-            gj[j].out = &pts[0, 0] if pts.shape[0] else NULL
-            gj[j].parts = _parts_ptr(parts, gj[j].n, nt)
-            keep.append((h, pts, parts))
-        for j in range(nj):
+                self.gj[j].x[a] = _coord_ptr(coords[a], self.gj[j].n) if a < len(coords) else NULL
+            self.gj[j].h = &h[0] if self.gj[j].n else NULL
+            self.gj[j].out = &pts[0, 0] if pts.shape[0] else NULL
+            self.gj[j].given = _given_parts(parts, &self.gj[j].ngiven)
+            self.keep.append(gathers[j])
+        for j in range(self.nj):
             off, nbrs, coords, h, pts, out, ends, parts = jobs[j]
-            cj[j].nd = h.shape[0]
-            if (off.shape[0] != cj[j].nd + 1 or out.shape[0] < nbrs.shape[0] or ends.shape[0] < cj[j].nd
-                    or pts.shape[1] != 4):
+            self.cj[j].nd = h.shape[0]
+            if (off.shape[0] != self.cj[j].nd + 1 or out.shape[0] < nbrs.shape[0]
+                    or ends.shape[0] < self.cj[j].nd or pts.shape[1] != 4):
                 raise ValueError("cut_rows: the list does not fit the arrays")
-            cj[j].off = _iptr(off)
-            cj[j].nbrs = _iptr(nbrs)
+            self.cj[j].off = _iptr(off)
+            self.cj[j].nbrs = _iptr(nbrs)
             for a in range(3):
-                cj[j].xd[a] = _coord_ptr(coords[a], cj[j].nd) if a < g.dim else NULL
-            cj[j].h = &h[0] if cj[j].nd else NULL
-            cj[j].pts = &pts[0, 0] if pts.shape[0] else NULL
-            cj[j].out = _iptr(out)
-            cj[j].ends = _iptr(ends)
-            cj[j].parts = _parts_ptr(parts, cj[j].nd, nt)
-            keep.append((off, nbrs, h, pts, out, ends, parts))
-        if ng or nm:
-            for k in prange(nt, nogil=True, schedule="static", num_threads=nt):
-                moved[8 * k] = 0.0        # largest |dx|^2
-                moved[8 * k + 1] = 0.0    # largest |dh|
-                moved[8 * k + 2] = 0.0    # count of non-finite results
-                for j in range(nm):
-                    lo = _cut(mj[j].parts, mj[j].n, k, nt)
-                    hi = _cut(mj[j].parts, mj[j].n, k + 1, nt)
-                    if hi > lo:
-                        _motion_chunk(g.dim, mj[j].x, mj[j].r, L, mj[j].h, mj[j].h_ref, lo, hi,
-                                      &moved[8 * k + 3])
-                        moved[8 * k + 2] += (not isfinite(moved[8 * k + 3])) + (not isfinite(moved[8 * k + 4]))
-                        moved[8 * k] = max(moved[8 * k], moved[8 * k + 3])
-                        moved[8 * k + 1] = max(moved[8 * k + 1], moved[8 * k + 4])
-                for j in range(ng):
-                    lo = _cut(gj[j].parts, gj[j].n, k, nt)
-                    hi = _cut(gj[j].parts, gj[j].n, k + 1, nt)
-                    for i in range(lo, hi):
-                        _record(gj[j].out, gj[j].x, gj[j].h, i, radius_scale)
-        if nm:
-            for k in range(nt):
-                if moved[8 * k + 2] != 0.0:
-                    return None
-                m2 = max(m2, moved[8 * k])
-                mh = max(mh, moved[8 * k + 1])
-            if not (2.0 * sqrt(m2) + radius_scale * mh <= skin_distance):
-                return None
-        # thread k cuts its own part of each list first, CUT_CLAIM rows at a time, then what
-        # is left of the others' parts of that list (a slowed core hands over its rest)
-        for j in range(nj):
-            for k in range(nt):
-                claims[8 * (j * nt + k)] = _cut(cj[j].parts, cj[j].nd, k, nt)
-        for k in prange(nt, nogil=True, schedule="static", num_threads=nt):
+                self.cj[j].xd[a] = _coord_ptr(coords[a], self.cj[j].nd) if a < g.dim else NULL
+            self.cj[j].h = &h[0] if self.cj[j].nd else NULL
+            self.cj[j].pts = &pts[0, 0] if pts.shape[0] else NULL
+            self.cj[j].out = _iptr(out)
+            self.cj[j].ends = _iptr(ends)
+            self.cj[j].given = _given_parts(parts, &self.cj[j].ngiven)
+            self.keep.append(jobs[j])
+
+    def __dealloc__(self):
+        free(self.cj)
+        free(self.gj)
+        free(self.mj)
+
+    def run(self, double skin_distance=0.0):
+        """Cut the lists (with the motions: only if the skin still covers them, else None);
+        the number of pairs of each list.  See :func:`cut_rows`."""
+        cdef const Grid* g = &self.grid.c
+        cdef int nt = max(1, min(sphgen_max_threads(), 64))
+        cdef Py_ssize_t nj = self.nj, ng = self.ng, nm = self.nm, j, i, lo, hi, cnt
+        cdef CutJob* cj = self.cj
+        cdef GatherJob* gj = self.gj
+        cdef MotionJob* mj = self.mj
+        cdef double radius_scale = self.radius_scale
+        cdef double* L = self.L
+        cdef int k, o, owner
+        cdef double m2 = 0.0, mh = 0.0
+        cdef bint open_box = g.dim >= 2 and not (g.periodic[0] or g.periodic[1] or g.periodic[2])
+        cdef Py_ssize_t* found = <Py_ssize_t*>malloc((nj * nt + 1) * sizeof(Py_ssize_t))
+        # where the unclaimed rows of part k of list j start (one cache line each)
+        cdef long* claims = <long*>malloc((8 * nj * nt + 1) * sizeof(long))
+        # per thread: largest |dx|^2 and |dh| of its parts (8 doubles apart: no shared line)
+        cdef double* moved = <double*>malloc((8 * nt + 2) * sizeof(double))
+        try:
+            if found == NULL or moved == NULL or claims == NULL:
+                raise MemoryError("cut_rows")
+            for j in range(nm):
+                mj[j].parts = _parts_for(mj[j].given, mj[j].ngiven, mj[j].n, nt)
+            for j in range(ng):
+                gj[j].parts = _parts_for(gj[j].given, gj[j].ngiven, gj[j].n, nt)
             for j in range(nj):
-                cnt = 0
-                for o in range(nt):
-                    owner = (k + o) % nt
-                    hi = _cut(cj[j].parts, cj[j].nd, owner + 1, nt)
-                    lo = sphgen_claim(&claims[8 * (j * nt + owner)], CUT_CLAIM)
-                    while lo < hi:
-                        cnt = cnt + _cut_part(g, open_box, &cj[j], lo, min(lo + CUT_CLAIM, hi), radius_scale)
+                cj[j].parts = _parts_for(cj[j].given, cj[j].ngiven, cj[j].nd, nt)
+            if ng or nm:
+                for k in prange(nt, nogil=True, schedule="static", num_threads=nt):
+                    moved[8 * k] = 0.0        # largest |dx|^2
+                    moved[8 * k + 1] = 0.0    # largest |dh|
+                    moved[8 * k + 2] = 0.0    # count of non-finite results
+                    for j in range(nm):
+                        lo = _cut(mj[j].parts, mj[j].n, k, nt)
+                        hi = _cut(mj[j].parts, mj[j].n, k + 1, nt)
+                        if hi > lo:
+                            _motion_chunk(g.dim, mj[j].x, mj[j].r, L, mj[j].h, mj[j].h_ref, lo, hi,
+                                          &moved[8 * k + 3])
+                            moved[8 * k + 2] += (not isfinite(moved[8 * k + 3])) + (not isfinite(moved[8 * k + 4]))
+                            moved[8 * k] = max(moved[8 * k], moved[8 * k + 3])
+                            moved[8 * k + 1] = max(moved[8 * k + 1], moved[8 * k + 4])
+                    for j in range(ng):
+                        lo = _cut(gj[j].parts, gj[j].n, k, nt)
+                        hi = _cut(gj[j].parts, gj[j].n, k + 1, nt)
+                        for i in range(lo, hi):
+                            _record(gj[j].out, gj[j].x, gj[j].h, i, radius_scale)
+            if nm:
+                for k in range(nt):
+                    if moved[8 * k + 2] != 0.0:
+                        return None
+                    m2 = max(m2, moved[8 * k])
+                    mh = max(mh, moved[8 * k + 1])
+                if not (2.0 * sqrt(m2) + radius_scale * mh <= skin_distance):
+                    return None
+            # thread k cuts its own part of each list first, CUT_CLAIM rows at a time, then
+            # what is left of the others' parts of that list (a slowed core hands over its rest)
+            for j in range(nj):
+                for k in range(nt):
+                    claims[8 * (j * nt + k)] = _cut(cj[j].parts, cj[j].nd, k, nt)
+            for k in prange(nt, nogil=True, schedule="static", num_threads=nt):
+                for j in range(nj):
+                    cnt = 0
+                    for o in range(nt):
+                        owner = (k + o) % nt
+                        hi = _cut(cj[j].parts, cj[j].nd, owner + 1, nt)
                         lo = sphgen_claim(&claims[8 * (j * nt + owner)], CUT_CLAIM)
-                found[j * nt + k] = cnt
-        return [sum(found[j * nt + k] for k in range(nt)) for j in range(nj)]
-    finally:
-        free(cj)
-        free(gj)
-        free(mj)
-        free(found)
-        free(moved)
-        free(claims)
+                        while lo < hi:
+                            cnt = cnt + _cut_part(g, open_box, &cj[j], lo, min(lo + CUT_CLAIM, hi),
+                                                  radius_scale)
+                            lo = sphgen_claim(&claims[8 * (j * nt + owner)], CUT_CLAIM)
+                    found[j * nt + k] = cnt
+            return [sum(found[j * nt + k] for k in range(nt)) for j in range(nj)]
+        finally:
+            free(found)
+            free(moved)
+            free(claims)
 
 
 def refine_csr(GridSpec grid, int[::1] offsets, int[::1] nbrs, list dest_coords,
