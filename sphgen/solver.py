@@ -43,7 +43,7 @@ class Solver:
     def __init__(self, scene, integrator, dt, tf, *, adaptive=False, dt_props=("dt_cfl",), cfl=1.0,
                  max_steps=None, pfreq=100, output_at_times=(), outdir=None, prefix="sphgen",
                  disable_output=False, progress=True, guard=True, speed_limit=None,
-                 density_bounds=None, neighbour_jump=4.0, sort_every=500, metadata=None,
+                 density_bounds=None, neighbour_jump=4.0, sort_every=200, metadata=None,
                  tune_threads=None):
         if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
             raise ValueError(f"time step dt={dt!r} must be a positive finite number")
@@ -73,10 +73,11 @@ class Solver:
         self.neighbour_exempt = set()
         # particles drift away from their memory neighbours; re-sorting keeps the
         # neighbour loops cache-friendly (carry a 'gid' property to track particles).  A
-        # sort costs a rebuild and a permutation of every array (1.4 ms on the dam break's
-        # 3 384 particles, 6.3 ms on Taylor-Green nx = 100) and the loops lose their order
-        # slowly (Taylor-Green nx = 100, 3 000 steps unsorted: 3 % on the step); every 500
-        # steps is near sqrt(2 x sort / loss per step^2) (docs/performance.md)
+        # sort costs a rebuild and a permutation of every array (1.5 ms on the dam break's
+        # 3 384 particles, 4.9 ms on Taylor-Green nx = 100); between sorts the passes lose
+        # little, but each rebuild's rows need more sorting (dam break 1.2 ms right after a
+        # sort, 1.36 ms 200 steps later, 1.65 ms 500 later; Taylor-Green 4.4, 7.1, 7.6 ms):
+        # every 200 steps costs least on both (docs/performance.md)
         self.sort_every = sort_every
         self.metadata = dict(metadata or {})
         # the thread count is an upper bound: under load one thread may be faster
