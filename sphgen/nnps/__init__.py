@@ -137,7 +137,9 @@ class NeighbourSearch:
 
     Attributes: ``n_updates``, ``n_builds`` (updates that rebuilt the cells),
     ``grid`` (the cell grid), ``cell_size`` and ``n_cells`` (per axis), ``arrays``,
-    ``dim``, ``radius_scale``, ``domain``, ``skin``, ``skin_distance`` (``s``).
+    ``dim``, ``radius_scale``, ``domain``, ``skin``, ``skin_distance`` (``s``),
+    ``row_version`` (changes whenever :meth:`rows_of` may hand out other arrays; see
+    :meth:`rows_unchanged`).
     """
 
     def __init__(self, arrays, dim, radius_scale, domain=None, sort=True, skin=0.0):
