@@ -26,6 +26,7 @@ import io
 import os
 import statistics
 import sys
+import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from roofline import host_line  # noqa: E402
@@ -83,9 +84,10 @@ def main():
     print(host_line())
     app = load_application(app_args[0])()
     app.post_process = lambda outdir: None
+    work = tempfile.TemporaryDirectory(prefix="thread_pairs_")
     with contextlib.redirect_stdout(io.StringIO()):
         app.run(list(app_args[1:]) + ["--max-steps", "1", "--disable-output", "--no-progress",
-                                      "--overwrite", "-d", f"/tmp/thread_pairs_{os.getpid()}", "--threads", "2"])
+                                      "--overwrite", "-d", os.path.join(work.name, "run"), "--threads", "2"])
     s = app.solver
     tf = s.tf
     timers, parts = None, {1: {}, 2: {}}
