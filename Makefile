@@ -6,7 +6,7 @@ STAMP  := $(VENV)/.installed
 
 .PHONY: run test test-slow bench docs clean pysph
 
-$(STAMP): setup.py pyproject.toml $(wildcard sphgen/nnps/*.pyx)
+$(STAMP): setup.py pyproject.toml $(wildcard sphgen/nnps/*.pyx) $(wildcard sphgen/nnps/*.h)
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -e .

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from sphgen.nnps import Domain, NeighbourSearch, NotFrozenError
+from sphgen.nnps import Domain, NeighbourSearch, NotFrozenError, _cell_list
 from sphgen.particles import ParticleArray
 
 AXES = ("x", "y", "z")
@@ -490,6 +490,47 @@ def test_skin_gives_the_exact_lists_and_rebuilds_only_when_needed(dim, periodic,
     assert with_skin.skin_distance > 0
     assert 2 <= with_skin.n_builds < with_skin.n_updates // 2    # reused, and rebuilt
     assert fresh.n_builds == fresh.n_updates + 1
+
+
+@pytest.mark.parametrize("dim", [1, 2, 3])
+@pytest.mark.parametrize("periodic", [False, True])
+def test_reach_tests_four_at_a_time_give_the_scalar_lists_entry_for_entry(dim, periodic):
+    """The AVX2 reach tests (sphgen_reach.h: the build's scan of a cell, the cut of a skin
+    row) keep exactly the candidates the scalar loops keep, in the same order: a lattice
+    whose spacing is the reach (pairs exactly at the cut-off, where one rounding decides)
+    jittered by a few ulps, two sizes of h, rows of every length modulo 4."""
+    if not _cell_list.reach_simd_available():
+        pytest.skip("this machine has no AVX2: only the scalar loops run")
+    rng = np.random.default_rng(7 + dim)
+    side = {1: 60, 2: 24, 3: 9}[dim]
+    grid = np.stack(np.meshgrid(*[np.arange(side)] * dim, indexing="ij"), -1).reshape(-1, dim)
+    dx = 1.0 / side
+    n = grid.shape[0]
+    props = {AXES[a]: (grid[:, a] + 0.5) * dx * (1.0 + 1e-15 * rng.integers(-3, 4, n))
+             if a < dim else np.zeros(n) for a in range(3)}
+    scale = {1: 5.0, 2: 2.0, 3: 1.0}[dim]         # the reach 2h: scale dx or 1.5 scale dx
+    props["h"] = np.where(rng.random(n) < 0.5, 0.5, 0.75) * scale * dx
+    dom = domain_for((periodic,) * dim)
+    results = {}
+    old = _cell_list.set_reach_simd(True)
+    try:
+        for simd in (True, False):
+            _cell_list.set_reach_simd(simd)
+            pa = ParticleArray("f", n=n, **{k: v.copy() for k, v in props.items()})
+            nn = NeighbourSearch([pa], dim, 2.0, dom, sort=False, skin=0.3)
+            lists = [nn.neighbours("f", "f")]        # the build's scan
+            for step in range(3):                    # the cut of the skin rows
+                pa.get("x")[:] += 0.02 * dx * np.sin(np.arange(n) + step)
+                nn.update()
+                lists.append(packed(*nn.rows("f", "f")[:3]))
+            assert nn.n_builds == 1
+            results[simd] = lists
+    finally:
+        _cell_list.set_reach_simd(old)
+    for got, ref in zip(results[True], results[False]):
+        assert_same_lists(got, ref)
+    lengths = np.concatenate([np.diff(offsets) for offsets, _ in results[True]])
+    assert np.unique(lengths % 4).size == 4 and lengths.max() >= 8
 
 
 @pytest.mark.parametrize("periodic", [False, True])

@@ -67,6 +67,36 @@ cdef extern from *:
 cdef extern from "sphgen_claim.h":
     long sphgen_claim(long* counter, long n) noexcept nogil
 
+cdef extern from "sphgen_reach.h":
+    int sphgen_reach_simd() noexcept nogil
+    long sphgen_cut_open_avx2(const int* nbrs, long k0, long k1, double xi, double yi, double zi,
+                              double ri2, const double* pts, int* out, int three_d) noexcept nogil
+    long sphgen_scan_cell_avx2(const double* xi, const double* pts, const int* index, long p0,
+                               long p1, const double* shift, int* out, int three_d) noexcept nogil
+    long sphgen_cut_image_avx2(const int* nbrs, long k0, long k1, double xi, double yi, double zi,
+                               double ri2, const double* pts, int* out, int three_d,
+                               const double* half, const double* length) noexcept nogil
+
+# the reach tests four candidates at a time (sphgen_reach.h) where the machine has AVX2
+cdef bint _REACH_SIMD_AVAILABLE = sphgen_reach_simd()
+cdef bint _REACH_SIMD = _REACH_SIMD_AVAILABLE
+
+
+def set_reach_simd(bint on):
+    """Use the four-at-a-time reach tests (``sphgen_reach.h``) if ``on`` and the machine
+    has them, the scalar loops otherwise; returns the previous setting.  The lists are
+    the same either way (for tests and measurements)."""
+    global _REACH_SIMD
+    old = _REACH_SIMD
+    _REACH_SIMD = on and _REACH_SIMD_AVAILABLE
+    return old
+
+
+def reach_simd_available():
+    """Whether this machine runs the four-at-a-time reach tests (AVX2)."""
+    return bool(_REACH_SIMD_AVAILABLE)
+
+
 # rows of a list a thread of cut_rows takes at a time
 cdef Py_ssize_t CUT_CLAIM = 64
 
@@ -446,6 +476,9 @@ cdef Py_ssize_t _scan_cell(int dim, const double* xi, const Bins* s, int cell,
     cdef double dx, dy, dz, r2, rc2
     cdef double x0 = xi[0], y0 = xi[1], z0 = xi[2], ri2 = xi[3]
     cdef double sx = shift[0], sy = shift[1], sz = shift[2]
+    if _REACH_SIMD:
+        return sphgen_scan_cell_avx2(xi, s.pts, s.index, s.start[cell], s.start[cell + 1], shift,
+                                     out, dim == 3)
     if dim == 3:
         for p in range(s.start[cell], s.start[cell + 1]):
             q = s.pts + 4 * p
@@ -950,13 +983,15 @@ cdef inline void _record(double* out, const double** x, const double* h, Py_ssiz
 
 cdef inline Py_ssize_t _cut_open(const int* nbrs, Py_ssize_t k0, Py_ssize_t k1, double xi,
                                  double yi, double zi, double ri2, const double* pts,
-                                 int* out) noexcept nogil:
+                                 int* out, bint three_d) noexcept nogil:
     """:func:`_refine_row` where no candidate is across a periodic edge: no per-candidate
     axis tests; in 2D the z terms are 0 - 0 (pts holds 0 there), and adding 0.0 leaves
     the build's sum unchanged."""
     cdef Py_ssize_t k, cnt = 0
     cdef const double* q
     cdef double dx, dy, dz, r2
+    if _REACH_SIMD:
+        return sphgen_cut_open_avx2(nbrs, k0, k1, xi, yi, zi, ri2, pts, out, three_d)
     for k in range(k0, k1):
         q = pts + 4 * nbrs[k]
         dx = xi - q[0]
@@ -998,13 +1033,14 @@ cdef inline Py_ssize_t _refine_row(const Grid* g, bint open_box, Py_ssize_t i, c
     cdef Py_ssize_t k, cnt = 0
     cdef const double* q
     cdef double dx, dy, dz, r2, xi, yi, zi, hx, hy, hz, lx, ly, lz
+    cdef double half[3]
     if k1 <= k0:      # most rows of a wall list are empty: no loads for them
         return 0
     xi = xd0[i]
     yi = xd1[i] if g.dim >= 2 else 0.0
     zi = xd2[i] if g.dim == 3 else 0.0
     if open_box or _off_the_edges(g, xi, yi, zi):
-        return _cut_open(nbrs, k0, k1, xi, yi, zi, ri2, pts, out)
+        return _cut_open(nbrs, k0, k1, xi, yi, zi, ri2, pts, out, g.dim == 3)
     # near a periodic edge: the minimum image on periodic axes (half = inf on the others,
     # so their tests never fire), the z terms 0 in 2D and y, z in 1D as above.  The box is
     # read into locals first: with -fno-strict-aliasing every store to ``out`` would
@@ -1015,6 +1051,12 @@ cdef inline Py_ssize_t _refine_row(const Grid* g, bint open_box, Py_ssize_t i, c
     lx = g.length[0]
     ly = g.length[1]
     lz = g.length[2]
+    if _REACH_SIMD:
+        half[0] = hx
+        half[1] = hy
+        half[2] = hz
+        return sphgen_cut_image_avx2(nbrs, k0, k1, xi, yi, zi, ri2, pts, out, g.dim == 3, half,
+                                     g.length)
     for k in range(k0, k1):
         q = pts + 4 * nbrs[k]
         dx = xi - q[0]
