@@ -495,11 +495,11 @@ def test_skin_gives_the_exact_lists_and_rebuilds_only_when_needed(dim, periodic,
 @pytest.mark.parametrize("dim", [1, 2, 3])
 @pytest.mark.parametrize("periodic", [False, True])
 def test_reach_tests_four_at_a_time_give_the_scalar_lists_entry_for_entry(dim, periodic):
-    """The AVX2 reach tests (sphgen_reach.h: the build's scan of a cell, the cut of a skin
+    """The AVX2 reach tests (sphgen_simd.h: the build's scan of a cell, the cut of a skin
     row) keep exactly the candidates the scalar loops keep, in the same order: a lattice
     whose spacing is the reach (pairs exactly at the cut-off, where one rounding decides)
     jittered by a few ulps, two sizes of h, rows of every length modulo 4."""
-    if not _cell_list.reach_simd_available():
+    if not _cell_list.simd_available():
         pytest.skip("this machine has no AVX2: only the scalar loops run")
     rng = np.random.default_rng(7 + dim)
     side = {1: 60, 2: 24, 3: 9}[dim]
@@ -512,10 +512,10 @@ def test_reach_tests_four_at_a_time_give_the_scalar_lists_entry_for_entry(dim, p
     props["h"] = np.where(rng.random(n) < 0.5, 0.5, 0.75) * scale * dx
     dom = domain_for((periodic,) * dim)
     results = {}
-    old = _cell_list.set_reach_simd(True)
+    old = _cell_list.set_simd(True)
     try:
         for simd in (True, False):
-            _cell_list.set_reach_simd(simd)
+            _cell_list.set_simd(simd)
             pa = ParticleArray("f", n=n, **{k: v.copy() for k, v in props.items()})
             nn = NeighbourSearch([pa], dim, 2.0, dom, sort=False, skin=0.3)
             lists = [nn.neighbours("f", "f")]        # the build's scan
@@ -526,11 +526,44 @@ def test_reach_tests_four_at_a_time_give_the_scalar_lists_entry_for_entry(dim, p
             assert nn.n_builds == 1
             results[simd] = lists
     finally:
-        _cell_list.set_reach_simd(old)
+        _cell_list.set_simd(old)
     for got, ref in zip(results[True], results[False]):
         assert_same_lists(got, ref)
     lengths = np.concatenate([np.diff(offsets) for offsets, _ in results[True]])
     assert np.unique(lengths % 4).size == 4 and lengths.max() >= 8
+
+
+@pytest.mark.parametrize("n", [1, 3, 4, 5, 8, 11])
+def test_the_periodic_wraps_look_four_at_a_time_finds_every_value_outside(n):
+    """wrap_periodic's AVX2 look (no value outside: nothing to do) misses no value outside
+    [lo, hi), at its ends, NaN or inf, in any lane or the tail; both paths leave the
+    same values and name the same non-finite index."""
+    if not _cell_list.simd_available():
+        pytest.skip("this machine has no AVX2: only the scalar loop runs")
+    lo, length = -0.5, 2.0
+    inside = np.linspace(lo, lo + length, n, endpoint=False) + 0.25 * length / n
+    cases = [inside]
+    for i in range(n):
+        for bad in (lo + length, np.nextafter(lo, -np.inf), lo + 3.7 * length, np.nan, np.inf, -np.inf):
+            x = inside.copy()
+            x[i] = bad
+            cases.append(x)
+    old = _cell_list.set_simd(True)
+    try:
+        for x in cases:
+            got = {}
+            for simd in (True, False):
+                _cell_list.set_simd(simd)
+                y = x.copy()
+                got[simd] = (_cell_list.wrap_periodic(y, lo, length), y)
+            assert got[True][0] == got[False][0]
+            np.testing.assert_array_equal(got[True][1], got[False][1])
+            finite = np.isfinite(x).all()
+            assert (got[True][0] == -1) == finite
+            if finite:
+                assert ((got[True][1] >= lo) & (got[True][1] < lo + length)).all()
+    finally:
+        _cell_list.set_simd(old)
 
 
 @pytest.mark.parametrize("periodic", [False, True])

@@ -67,8 +67,8 @@ cdef extern from *:
 cdef extern from "sphgen_claim.h":
     long sphgen_claim(long* counter, long n) noexcept nogil
 
-cdef extern from "sphgen_reach.h":
-    int sphgen_reach_simd() noexcept nogil
+cdef extern from "sphgen_simd.h":
+    int sphgen_simd_available() noexcept nogil
     long sphgen_cut_open_avx2(const int* nbrs, long k0, long k1, double xi, double yi, double zi,
                               double ri2, const double* pts, int* out, int three_d) noexcept nogil
     long sphgen_scan_cell_avx2(const double* xi, const double* pts, const int* index, long p0,
@@ -76,25 +76,28 @@ cdef extern from "sphgen_reach.h":
     long sphgen_cut_image_avx2(const int* nbrs, long k0, long k1, double xi, double yi, double zi,
                                double ri2, const double* pts, int* out, int three_d,
                                const double* half, const double* length) noexcept nogil
+    int sphgen_outside_avx2(const double* x, long n, double lo, double hi) noexcept nogil
 
-# the reach tests four candidates at a time (sphgen_reach.h) where the machine has AVX2
-cdef bint _REACH_SIMD_AVAILABLE = sphgen_reach_simd()
-cdef bint _REACH_SIMD = _REACH_SIMD_AVAILABLE
+# the reach tests four candidates at a time, and the periodic wrap's look, where the machine
+# has AVX2 (sphgen_simd.h)
+cdef bint _SIMD_AVAILABLE = sphgen_simd_available()
+cdef bint _SIMD = _SIMD_AVAILABLE
 
 
-def set_reach_simd(bint on):
-    """Use the four-at-a-time reach tests (``sphgen_reach.h``) if ``on`` and the machine
-    has them, the scalar loops otherwise; returns the previous setting.  The lists are
-    the same either way (for tests and measurements)."""
-    global _REACH_SIMD
-    old = _REACH_SIMD
-    _REACH_SIMD = on and _REACH_SIMD_AVAILABLE
+def set_simd(bint on):
+    """Use the four-at-a-time loops (``sphgen_simd.h``: the reach tests, the periodic
+    wrap's look) if ``on`` and the machine has AVX2, the scalar loops otherwise; returns
+    the previous setting.  The lists and positions are the same either way (for tests
+    and measurements)."""
+    global _SIMD
+    old = _SIMD
+    _SIMD = on and _SIMD_AVAILABLE
     return old
 
 
-def reach_simd_available():
-    """Whether this machine runs the four-at-a-time reach tests (AVX2)."""
-    return bool(_REACH_SIMD_AVAILABLE)
+def simd_available():
+    """Whether this machine runs the four-at-a-time loops (AVX2)."""
+    return bool(_SIMD_AVAILABLE)
 
 
 # rows of a list a thread of cut_rows takes at a time
@@ -476,7 +479,7 @@ cdef Py_ssize_t _scan_cell(int dim, const double* xi, const Bins* s, int cell,
     cdef double dx, dy, dz, r2, rc2
     cdef double x0 = xi[0], y0 = xi[1], z0 = xi[2], ri2 = xi[3]
     cdef double sx = shift[0], sy = shift[1], sz = shift[2]
-    if _REACH_SIMD:
+    if _SIMD:
         return sphgen_scan_cell_avx2(xi, s.pts, s.index, s.start[cell], s.start[cell + 1], shift,
                                      out, dim == 3)
     if dim == 3:
@@ -666,9 +669,12 @@ cdef Py_ssize_t _make_blocks(const Bins* d, Py_ssize_t ncells, Py_ssize_t target
 def wrap_periodic(double[::1] x, double lo, double length):
     """Wrap ``x`` in place into ``[lo, lo + length)``.
 
-    Returns the index of the first non-finite value (left unchanged), or -1."""
+    Returns the index of the first non-finite value (left unchanged), or -1.  With AVX2,
+    a branch-free look first: at most updates no value is outside."""
     cdef Py_ssize_t i, n = x.shape[0]
     cdef double v, hi = lo + length
+    if _SIMD and n and not sphgen_outside_avx2(&x[0], n, lo, hi):
+        return -1
     for i in range(n):
         v = x[i]
         if not isfinite(v):
@@ -990,7 +996,7 @@ cdef inline Py_ssize_t _cut_open(const int* nbrs, Py_ssize_t k0, Py_ssize_t k1, 
     cdef Py_ssize_t k, cnt = 0
     cdef const double* q
     cdef double dx, dy, dz, r2
-    if _REACH_SIMD:
+    if _SIMD:
         return sphgen_cut_open_avx2(nbrs, k0, k1, xi, yi, zi, ri2, pts, out, three_d)
     for k in range(k0, k1):
         q = pts + 4 * nbrs[k]
@@ -1051,7 +1057,7 @@ cdef inline Py_ssize_t _refine_row(const Grid* g, bint open_box, Py_ssize_t i, c
     lx = g.length[0]
     ly = g.length[1]
     lz = g.length[2]
-    if _REACH_SIMD:
+    if _SIMD:
         half[0] = hx
         half[1] = hy
         half[2] = hz

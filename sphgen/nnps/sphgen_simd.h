@@ -1,4 +1,5 @@
-/* The reach test of the neighbour search, four candidates at a time (AVX2).
+/* Loops of the neighbour search four doubles at a time (AVX2): the reach test, and the
+ * look for positions outside a periodic box.
  *
  * A candidate j of destination i is kept if |x_i - x_j|^2 < max((k h_i)^2, (k h_j)^2).
  * Two loops make that test on every candidate: the build's scan of a cell
@@ -12,16 +13,21 @@
  * kept indices packed with one byte shuffle from a table of sixteen.  The rows are
  * the same, bit for bit; tests compare both paths.
  *
+ * wrap_periodic looks at every coordinate on a periodic axis at every update, and at
+ * most updates none is outside the box: sphgen_outside_avx2 says whether one is (or is
+ * not finite) with two compares per four values and no branch, before the scalar loop
+ * that wraps them runs at all.
+ *
  * The functions are compiled for AVX2 whatever the build's flags and chosen at run
- * time (sphgen_reach_simd()); other machines and compilers use the scalar loops. */
-#ifndef SPHGEN_REACH_H
-#define SPHGEN_REACH_H
+ * time (sphgen_simd_available()); other machines and compilers use the scalar loops. */
+#ifndef SPHGEN_SIMD_H
+#define SPHGEN_SIMD_H
 
 #if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
-#define SPHGEN_REACH_AVX2 1
+#define SPHGEN_SIMD_AVX2 1
 #include <immintrin.h>
 
-static int sphgen_reach_simd(void) {
+static int sphgen_simd_available(void) {
     __builtin_cpu_init();
     return __builtin_cpu_supports("avx2") ? 1 : 0;
 }
@@ -193,9 +199,26 @@ static long sphgen_scan_cell_avx2(const double* xi, const double* pts, const int
     return cnt;
 }
 
+/* whether some x[i] is not in [lo, hi) (NaN and inf included) */
+__attribute__((target("avx2")))
+static int sphgen_outside_avx2(const double* x, long n, double lo, double hi) {
+    long i = 0;
+    const __m256d vlo = _mm256_set1_pd(lo), vhi = _mm256_set1_pd(hi);
+    __m256d acc = _mm256_setzero_pd();
+    for (; i + 4 <= n; i += 4) {
+        __m256d v = _mm256_loadu_pd(x + i);
+        acc = _mm256_or_pd(acc, _mm256_or_pd(_mm256_cmp_pd(v, vlo, _CMP_NGE_UQ),
+                                             _mm256_cmp_pd(v, vhi, _CMP_NLT_UQ)));
+    }
+    for (; i < n; i++)
+        if (!(x[i] >= lo && x[i] < hi))
+            return 1;
+    return _mm256_movemask_pd(acc) != 0;
+}
+
 #else  /* no AVX2 path: the scalar loops of _cell_list.pyx */
-#define SPHGEN_REACH_AVX2 0
-static int sphgen_reach_simd(void) { return 0; }
+#define SPHGEN_SIMD_AVX2 0
+static int sphgen_simd_available(void) { return 0; }
 static long sphgen_cut_open_avx2(const int* nbrs, long k0, long k1, double xi, double yi,
                                  double zi, double ri2, const double* pts, int* out,
                                  int three_d) { return 0; }
@@ -205,6 +228,7 @@ static long sphgen_scan_cell_avx2(const double* xi, const double* pts, const int
 static long sphgen_cut_image_avx2(const int* nbrs, long k0, long k1, double xi, double yi,
                                   double zi, double ri2, const double* pts, int* out,
                                   int three_d, const double* half, const double* length) { return 0; }
+static int sphgen_outside_avx2(const double* x, long n, double lo, double hi) { return 1; }
 #endif
 
 #endif

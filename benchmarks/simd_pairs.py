@@ -1,12 +1,12 @@
-"""The reach tests four at a time (``sphgen_reach.h``) against the scalar loops, on the same work.
+"""The neighbour search's AVX2 loops (``sphgen_simd.h``) against the scalar ones, on the same work.
 
 Like ``thread_pairs.py``: one process runs the application in windows of ``--steps`` steps;
-each window is computed twice from the same saved state, once with the scalar reach tests
-and once with the AVX2 ones (``sphgen.nnps._cell_list.set_reach_simd``), in alternating
-order, with ``--threads`` threads.  Both give the same neighbour rows, so both runs take the
-same steps through the same states; the times differ by the reach tests and the host's drift.
+each window is computed twice from the same saved state, once with the scalar loops (the
+reach tests, the periodic wrap's look) and once with the AVX2 ones
+(``sphgen.nnps._cell_list.set_simd``), in alternating order, with ``--threads`` threads.  Both give the same neighbour rows, so both runs take the
+same steps through the same states; the times differ by those loops and the host's drift.
 
-    python benchmarks/reach_pairs.py [--steps 200] [--threads 1] [APP ARGS ...]
+    python benchmarks/simd_pairs.py [--steps 200] [--threads 1] [APP ARGS ...]
     (default APP ARGS: dam_break_2d --tf 0.7)
 """
 import argparse
@@ -32,12 +32,12 @@ def main():
     os.environ["SPHGEN_TUNE_THREADS"] = "0"
     from sphgen.app import load_application
     from sphgen.nnps import _cell_list
-    if not _cell_list.reach_simd_available():
-        sys.exit("reach_pairs: this machine has no AVX2; only the scalar reach tests run")
+    if not _cell_list.simd_available():
+        sys.exit("simd_pairs: this machine has no AVX2; only the scalar loops run")
     print(host_line())
     app = load_application(app_args[0])()
     app.post_process = lambda outdir: None
-    work = tempfile.TemporaryDirectory(prefix="reach_pairs_")
+    work = tempfile.TemporaryDirectory(prefix="simd_pairs_")
     with contextlib.redirect_stdout(io.StringIO()):
         app.run(list(app_args[1:]) + ["--max-steps", "1", "--disable-output", "--no-progress",
                                       "--overwrite", "-d", os.path.join(work.name, "run"),
@@ -52,7 +52,7 @@ def main():
         for k, simd in enumerate(order):
             if k:
                 saved.restore()
-            _cell_list.set_reach_simd(simd)
+            _cell_list.set_simd(simd)
             step0 = s.step
             times[simd] = window(app, args.threads, args.steps)
             steps = s.step - step0
@@ -61,7 +61,7 @@ def main():
     t0, t1 = sum(r[1] for r in rows), sum(r[2] for r in rows)
     ratios = [r[1] / r[2] for r in rows]
     print(f"sphgen run {' '.join(app_args)}, {args.threads} thread(s): {len(rows)} windows, {n} steps")
-    print(f"scalar reach tests {1e3 * t0 / n:.4f} ms/step, four at a time {1e3 * t1 / n:.4f} ms/step: "
+    print(f"scalar loops {1e3 * t0 / n:.4f} ms/step, four at a time {1e3 * t1 / n:.4f} ms/step: "
           f"{t0 / t1:.3f}x (windows: median {statistics.median(ratios):.3f}x)")
     print(host_line())
 
