@@ -10,16 +10,13 @@ same steps through the same states; the times differ by those loops and the host
     (default APP ARGS: dam_break_2d --tf 0.7)
 """
 import argparse
-import contextlib
-import io
 import os
 import statistics
 import sys
-import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from roofline import host_line  # noqa: E402
-from thread_pairs import Saved, window  # noqa: E402
+from thread_pairs import Saved, start, window  # noqa: E402
 
 
 def main():
@@ -30,18 +27,11 @@ def main():
     args = ap.parse_args()
     app_args = args.app or ["dam_break_2d", "--tf", "0.7"]
     os.environ["SPHGEN_TUNE_THREADS"] = "0"
-    from sphgen.app import load_application
     from sphgen.nnps import _cell_list
     if not _cell_list.simd_available():
         sys.exit("simd_pairs: this machine has no AVX2; only the scalar loops run")
     print(host_line())
-    app = load_application(app_args[0])()
-    app.post_process = lambda outdir: None
-    work = tempfile.TemporaryDirectory(prefix="simd_pairs_")
-    with contextlib.redirect_stdout(io.StringIO()):
-        app.run(list(app_args[1:]) + ["--max-steps", "1", "--disable-output", "--no-progress",
-                                      "--overwrite", "-d", os.path.join(work.name, "run"),
-                                      "--threads", str(args.threads)])
+    app, work = start(app_args, args.threads, "simd_pairs_")
     s = app.solver
     tf = s.tf
     rows = []

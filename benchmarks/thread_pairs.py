@@ -61,6 +61,20 @@ def rebuild(app):
     app.scene.engine.bind_neighbours()
 
 
+def start(app_args, threads, prefix):
+    """The application of ``app_args`` run in-process for one step (no output, its run folder
+    in a temporary directory, returned too: removed when it is dropped)."""
+    from sphgen.app import load_application
+    app = load_application(app_args[0])()
+    app.post_process = lambda outdir: None
+    work = tempfile.TemporaryDirectory(prefix=prefix)
+    with contextlib.redirect_stdout(io.StringIO()):
+        app.run(list(app_args[1:]) + ["--max-steps", "1", "--disable-output", "--no-progress",
+                                      "--overwrite", "-d", os.path.join(work.name, "run"),
+                                      "--threads", str(threads)])
+    return app, work
+
+
 def window(app, threads, steps):
     """Run ``steps`` steps with ``threads`` threads; the time loop's wall time."""
     s = app.solver
@@ -80,14 +94,8 @@ def main():
     args = ap.parse_args()
     app_args = args.app or ["dam_break_2d", "--tf", "0.7"]
     os.environ["SPHGEN_TUNE_THREADS"] = "0"
-    from sphgen.app import load_application
     print(host_line())
-    app = load_application(app_args[0])()
-    app.post_process = lambda outdir: None
-    work = tempfile.TemporaryDirectory(prefix="thread_pairs_")
-    with contextlib.redirect_stdout(io.StringIO()):
-        app.run(list(app_args[1:]) + ["--max-steps", "1", "--disable-output", "--no-progress",
-                                      "--overwrite", "-d", os.path.join(work.name, "run"), "--threads", "2"])
+    app, work = start(app_args, 2, "thread_pairs_")
     s = app.solver
     tf = s.tf
     timers, parts = None, {1: {}, 2: {}}

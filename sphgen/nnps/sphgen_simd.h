@@ -56,6 +56,24 @@ static const unsigned char sphgen_pack_table[16][16] __attribute__((aligned(16))
         R = _mm256_permute2f128_pd(t1_, t3_, 0x31);                   \
     } while (0)
 
+/* dx^2 + dy^2 (+ dz^2 in 3D), summed in that order as the scalar loops do */
+__attribute__((target("avx2")))
+static inline __m256d sphgen_r2_4(__m256d dx, __m256d dy, __m256d dz, int three_d) {
+    __m256d r2 = _mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy));
+    return three_d ? _mm256_add_pd(r2, _mm256_mul_pd(dz, dz)) : r2;
+}
+
+/* one candidate of a loop's tail: index j kept if dx^2 + dy^2 (+ dz^2) < max(ri2, rj2) */
+__attribute__((target("avx2")))
+static inline long sphgen_keep1(double dx, double dy, double dz, int three_d, double ri2,
+                                double rj2, int j, int* out, long cnt) {
+    double r2 = dx * dx + dy * dy;
+    if (three_d)
+        r2 = r2 + dz * dz;
+    out[cnt] = j;
+    return cnt + (r2 < (ri2 > rj2 ? ri2 : rj2));
+}
+
 /* keep the lanes of idx where r2 < max(ri2, rj2); returns the new count */
 __attribute__((target("avx2")))
 static inline long sphgen_keep4(__m256d r2, __m256d ri2, __m256d rj2, __m128i idx,
@@ -78,28 +96,17 @@ static long sphgen_cut_open_avx2(const int* nbrs, long k0, long k1, double xi, d
     const __m256d vr = _mm256_set1_pd(ri2);
     for (; k + 4 <= k1; k += 4) {
         __m128i idx = _mm_loadu_si128((const __m128i*)(nbrs + k));
-        __m256d X, Y, Z, R, dx, dy, dz, r2;
+        __m256d X, Y, Z, R, r2;
         SPHGEN_TRANSPOSE(_mm256_loadu_pd(pts + 4 * (long)nbrs[k]),
                          _mm256_loadu_pd(pts + 4 * (long)nbrs[k + 1]),
                          _mm256_loadu_pd(pts + 4 * (long)nbrs[k + 2]),
                          _mm256_loadu_pd(pts + 4 * (long)nbrs[k + 3]), X, Y, Z, R);
-        dx = _mm256_sub_pd(vx, X);
-        dy = _mm256_sub_pd(vy, Y);
-        r2 = _mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy));
-        if (three_d) {
-            dz = _mm256_sub_pd(vz, Z);
-            r2 = _mm256_add_pd(r2, _mm256_mul_pd(dz, dz));
-        }
+        r2 = sphgen_r2_4(_mm256_sub_pd(vx, X), _mm256_sub_pd(vy, Y), _mm256_sub_pd(vz, Z), three_d);
         cnt = sphgen_keep4(r2, vr, R, idx, out, cnt);
     }
     for (; k < k1; k++) {
         const double* q = pts + 4 * (long)nbrs[k];
-        double dx = xi - q[0], dy = yi - q[1], dz = zi - q[2];
-        double r2 = dx * dx + dy * dy;
-        if (three_d)
-            r2 = r2 + dz * dz;
-        out[cnt] = nbrs[k];
-        cnt += r2 < (ri2 > q[3] ? ri2 : q[3]);
+        cnt = sphgen_keep1(xi - q[0], yi - q[1], zi - q[2], three_d, ri2, q[3], nbrs[k], out, cnt);
     }
     return cnt;
 }
@@ -127,23 +134,19 @@ static long sphgen_cut_image_avx2(const int* nbrs, long k0, long k1, double xi, 
     const __m256d lx = _mm256_set1_pd(length[0]), ly = _mm256_set1_pd(length[1]), lz = _mm256_set1_pd(length[2]);
     for (; k + 4 <= k1; k += 4) {
         __m128i idx = _mm_loadu_si128((const __m128i*)(nbrs + k));
-        __m256d X, Y, Z, R, dx, dy, dz, r2;
+        __m256d X, Y, Z, R, r2;
         SPHGEN_TRANSPOSE(_mm256_loadu_pd(pts + 4 * (long)nbrs[k]),
                          _mm256_loadu_pd(pts + 4 * (long)nbrs[k + 1]),
                          _mm256_loadu_pd(pts + 4 * (long)nbrs[k + 2]),
                          _mm256_loadu_pd(pts + 4 * (long)nbrs[k + 3]), X, Y, Z, R);
-        dx = sphgen_image4(_mm256_sub_pd(vx, X), hx, lx);
-        dy = sphgen_image4(_mm256_sub_pd(vy, Y), hy, ly);
-        r2 = _mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy));
-        if (three_d) {
-            dz = sphgen_image4(_mm256_sub_pd(vz, Z), hz, lz);
-            r2 = _mm256_add_pd(r2, _mm256_mul_pd(dz, dz));
-        }
+        r2 = sphgen_r2_4(sphgen_image4(_mm256_sub_pd(vx, X), hx, lx),
+                         sphgen_image4(_mm256_sub_pd(vy, Y), hy, ly),
+                         sphgen_image4(_mm256_sub_pd(vz, Z), hz, lz), three_d);
         cnt = sphgen_keep4(r2, vr, R, idx, out, cnt);
     }
     for (; k < k1; k++) {
         const double* q = pts + 4 * (long)nbrs[k];
-        double d[3] = {xi - q[0], yi - q[1], zi - q[2]}, r2;
+        double d[3] = {xi - q[0], yi - q[1], zi - q[2]};
         int a;
         for (a = 0; a < 3; a++) {
             if (d[a] > half[a])
@@ -151,11 +154,7 @@ static long sphgen_cut_image_avx2(const int* nbrs, long k0, long k1, double xi, 
             else if (d[a] < -half[a])
                 d[a] = d[a] + length[a];
         }
-        r2 = d[0] * d[0] + d[1] * d[1];
-        if (three_d)
-            r2 = r2 + d[2] * d[2];
-        out[cnt] = nbrs[k];
-        cnt += r2 < (ri2 > q[3] ? ri2 : q[3]);
+        cnt = sphgen_keep1(d[0], d[1], d[2], three_d, ri2, q[3], nbrs[k], out, cnt);
     }
     return cnt;
 }
@@ -175,26 +174,17 @@ static long sphgen_scan_cell_avx2(const double* xi, const double* pts, const int
     for (; p + 4 <= p1; p += 4) {
         const double* q = pts + 4 * p;
         __m128i idx = _mm_loadu_si128((const __m128i*)(index + p));
-        __m256d X, Y, Z, R, dx, dy, dz, r2;
+        __m256d X, Y, Z, R, r2;
         SPHGEN_TRANSPOSE(_mm256_loadu_pd(q), _mm256_loadu_pd(q + 4), _mm256_loadu_pd(q + 8),
                          _mm256_loadu_pd(q + 12), X, Y, Z, R);
-        dx = _mm256_add_pd(_mm256_sub_pd(vx, X), vsx);
-        dy = _mm256_add_pd(_mm256_sub_pd(vy, Y), vsy);
-        r2 = _mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy));
-        if (three_d) {
-            dz = _mm256_add_pd(_mm256_sub_pd(vz, Z), vsz);
-            r2 = _mm256_add_pd(r2, _mm256_mul_pd(dz, dz));
-        }
+        r2 = sphgen_r2_4(_mm256_add_pd(_mm256_sub_pd(vx, X), vsx), _mm256_add_pd(_mm256_sub_pd(vy, Y), vsy),
+                         _mm256_add_pd(_mm256_sub_pd(vz, Z), vsz), three_d);
         cnt = sphgen_keep4(r2, vr, R, idx, out, cnt);
     }
     for (; p < p1; p++) {
         const double* q = pts + 4 * p;
-        double dx = (x0 - q[0]) + sx, dy = (y0 - q[1]) + sy, dz = (z0 - q[2]) + sz;
-        double r2 = dx * dx + dy * dy;
-        if (three_d)
-            r2 = r2 + dz * dz;
-        out[cnt] = index[p];
-        cnt += r2 < (ri2 > q[3] ? ri2 : q[3]);
+        cnt = sphgen_keep1((x0 - q[0]) + sx, (y0 - q[1]) + sy, (z0 - q[2]) + sz, three_d, ri2, q[3],
+                           index[p], out, cnt);
     }
     return cnt;
 }
