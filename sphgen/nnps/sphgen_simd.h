@@ -56,6 +56,13 @@ static const unsigned char sphgen_pack_table[16][16] __attribute__((aligned(16))
         R = _mm256_permute2f128_pd(t1_, t3_, 0x31);                   \
     } while (0)
 
+/* the records of the four sources j[0..3], transposed as above */
+#define SPHGEN_GATHER4(pts, j, X, Y, Z, R)                                            \
+    SPHGEN_TRANSPOSE(_mm256_loadu_pd((pts) + 4 * (long)(j)[0]),                       \
+                     _mm256_loadu_pd((pts) + 4 * (long)(j)[1]),                       \
+                     _mm256_loadu_pd((pts) + 4 * (long)(j)[2]),                       \
+                     _mm256_loadu_pd((pts) + 4 * (long)(j)[3]), X, Y, Z, R)
+
 /* dx^2 + dy^2 (+ dz^2 in 3D), summed in that order as the scalar loops do */
 __attribute__((target("avx2")))
 static inline __m256d sphgen_r2_4(__m256d dx, __m256d dy, __m256d dz, int three_d) {
@@ -95,12 +102,9 @@ static long sphgen_cut_open_avx2(const int* nbrs, long k0, long k1, double xi, d
     const __m256d vx = _mm256_set1_pd(xi), vy = _mm256_set1_pd(yi), vz = _mm256_set1_pd(zi);
     const __m256d vr = _mm256_set1_pd(ri2);
     for (; k + 4 <= k1; k += 4) {
-        __m128i idx = _mm_loadu_si128((const __m128i*)(nbrs + k));
+        const __m128i idx = _mm_loadu_si128((const __m128i*)(nbrs + k));
         __m256d X, Y, Z, R, r2;
-        SPHGEN_TRANSPOSE(_mm256_loadu_pd(pts + 4 * (long)nbrs[k]),
-                         _mm256_loadu_pd(pts + 4 * (long)nbrs[k + 1]),
-                         _mm256_loadu_pd(pts + 4 * (long)nbrs[k + 2]),
-                         _mm256_loadu_pd(pts + 4 * (long)nbrs[k + 3]), X, Y, Z, R);
+        SPHGEN_GATHER4(pts, nbrs + k, X, Y, Z, R);
         r2 = sphgen_r2_4(_mm256_sub_pd(vx, X), _mm256_sub_pd(vy, Y), _mm256_sub_pd(vz, Z), three_d);
         cnt = sphgen_keep4(r2, vr, R, idx, out, cnt);
     }
@@ -133,12 +137,9 @@ static long sphgen_cut_image_avx2(const int* nbrs, long k0, long k1, double xi, 
     const __m256d hx = _mm256_set1_pd(half[0]), hy = _mm256_set1_pd(half[1]), hz = _mm256_set1_pd(half[2]);
     const __m256d lx = _mm256_set1_pd(length[0]), ly = _mm256_set1_pd(length[1]), lz = _mm256_set1_pd(length[2]);
     for (; k + 4 <= k1; k += 4) {
-        __m128i idx = _mm_loadu_si128((const __m128i*)(nbrs + k));
+        const __m128i idx = _mm_loadu_si128((const __m128i*)(nbrs + k));
         __m256d X, Y, Z, R, r2;
-        SPHGEN_TRANSPOSE(_mm256_loadu_pd(pts + 4 * (long)nbrs[k]),
-                         _mm256_loadu_pd(pts + 4 * (long)nbrs[k + 1]),
-                         _mm256_loadu_pd(pts + 4 * (long)nbrs[k + 2]),
-                         _mm256_loadu_pd(pts + 4 * (long)nbrs[k + 3]), X, Y, Z, R);
+        SPHGEN_GATHER4(pts, nbrs + k, X, Y, Z, R);
         r2 = sphgen_r2_4(sphgen_image4(_mm256_sub_pd(vx, X), hx, lx),
                          sphgen_image4(_mm256_sub_pd(vy, Y), hy, ly),
                          sphgen_image4(_mm256_sub_pd(vz, Z), hz, lz), three_d);
