@@ -38,7 +38,9 @@ class BuildExt(build_ext):
             print("sphgen: the C compiler has no OpenMP; the neighbour search builds serial",
                   file=sys.stderr)
         for ext in self.extensions:
-            ext.extra_compile_args += ["-O3"] + cflags
+            # no multiply-add contracted, whatever CFLAGS say (-march=native enables FMA): the
+            # distances of the build, the cut and the skin check must round as written
+            ext.extra_compile_args += ["-O3", "-ffp-contract=off"] + cflags
             ext.extra_link_args += lflags
         super().build_extensions()
 
