@@ -9,7 +9,7 @@
  * vectorise them: the kept indices are packed to the front of the output, so each
  * store depends on the count so far.  Here four records are loaded and transposed,
  * the four distances computed with the same operations in the same order as the
- * scalar loops (no fused multiply-add, see the pragma below), and the
+ * scalar loops (no fused multiply-add: setup.py builds with -ffp-contract=off), and the
  * kept indices packed with one byte shuffle from a table of sixteen.  The rows are
  * the same, bit for bit; tests compare both paths.
  *
@@ -26,15 +26,6 @@
 #if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
 #define SPHGEN_SIMD_AVX2 1
 #include <immintrin.h>
-
-/* no multiply-add contracted, whatever the build's flags (-march=native enables FMA): the
- * vector lanes and the scalar tails must round alike */
-#if defined(__clang__)
-#pragma clang fp contract(off)
-#else
-#pragma GCC push_options
-#pragma GCC optimize("fp-contract=off")
-#endif
 
 static int sphgen_simd_available(void) {
     __builtin_cpu_init();
@@ -215,10 +206,6 @@ static int sphgen_outside_avx2(const double* x, long n, double lo, double hi) {
             return 1;
     return _mm256_movemask_pd(acc) != 0;
 }
-
-#if !defined(__clang__)
-#pragma GCC pop_options
-#endif
 
 #else  /* no AVX2 path: the scalar loops of _cell_list.pyx */
 #define SPHGEN_SIMD_AVX2 0
