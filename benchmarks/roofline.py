@@ -85,6 +85,33 @@ def regions(long n, double[::1] data, bint hand_over):
             for i in range(lo, hi):
                 data[i] = data[i] + 1.0
     return data[0]
+
+
+cdef long _keep_near(const int* nbrs, long m, const double* rec, int* out) noexcept nogil:
+    """The cut's kind of loop: read an index, gather its record, keep the index if the
+    record lies within a radius (branch-free store); the count kept."""
+    cdef long i, c = 0
+    cdef int j
+    cdef double dx, dy
+    for i in range(m):
+        j = nbrs[i]
+        dx = rec[4 * j] - 0.5
+        dy = rec[4 * j + 1] - 0.5
+        out[c] = j
+        c += dx * dx + dy * dy < 0.232
+    return c
+
+
+def keep_near_cores(long reps, int threads, int[:, ::1] nbrs, double[:, ::1] rec, int[:, ::1] out):
+    """_keep_near ``reps`` times on each of ``threads`` threads at once, thread k on row k
+    of every argument (its own data, nothing shared)."""
+    cdef int k
+    cdef long r, s = 0
+    cdef long m = nbrs.shape[1]
+    for k in prange(threads, nogil=True, num_threads=threads, schedule='static'):
+        for r in range(reps):
+            s += _keep_near(&nbrs[k, 0], m, &rec[k, 0], &out[k, 0])
+    return s
 '''
 
 
@@ -152,13 +179,32 @@ def two_core_fma(n=25_000_000, repeat=5):
     return 2.0 * float(np.median(times[1])) / float(np.median(times[2]))
 
 
+def two_core_gathers(reps=2_000, repeat=5, m=37_500, records=4_096):
+    """As :func:`two_core_fma` for the neighbour search's kind of work: each thread keeps
+    the indices of its own 150 kB of indices whose records (its own 128 kB) lie within a
+    radius, as the cut of the skin rows does; everything stays in the thread's own L2, and
+    nothing is shared.  The most a second core of this VM gives such a loop at that moment."""
+    mod = _module()
+    rng = np.random.default_rng(0)
+    nbrs = rng.integers(0, records, size=(2, m)).astype(np.int32)
+    rec = rng.random((2, 4 * records))
+    out = np.empty((2, m), dtype=np.int32)
+    mod.keep_near_cores(reps // 10, 2, nbrs, rec, out)
+    times = {1: [], 2: []}
+    for _ in range(repeat):
+        for k in (1, 2):
+            times[k].append(_timed(lambda r: mod.keep_near_cores(r, k, nbrs, rec, out), reps))
+    return 2.0 * float(np.median(times[1])) / float(np.median(times[2]))
+
+
 def host_line():
-    """One line for a benchmark's output: the load, the two cores' FMA ceiling and the
-    host's cross-core costs."""
+    """One line for a benchmark's output: the load, the two cores' ceilings (FMA chains,
+    and the cut's kind of gathers) and the host's cross-core costs."""
     import os
     c = cross_core_us()
     return (f"host: load average {os.getloadavg()[0]:.2f}; two cores give {two_core_fma():.2f}x one "
-            f"core's FMA rate; a two-thread region {c['region']:.2f} us, "
+            f"core's FMA rate, {two_core_gathers():.2f}x its rate of cache-bound gathers; "
+            f"a two-thread region {c['region']:.2f} us, "
             f"with its 16 kB handed between the cores {c['hand_over']:.2f} us")
 
 
