@@ -14,13 +14,13 @@ def test_the_gathers_ceiling_keeps_what_numpy_keeps_on_one_and_two_threads():
     import roofline
     mod = roofline._module()
     rng = np.random.default_rng(3)
-    nbrs = rng.integers(0, 64, size=(2, 1001)).astype(np.int32)
-    rec = rng.random((2, 4 * 64))
+    nbrs = rng.integers(0, 4096, size=(2, 20001)).astype(np.int32)
+    rec = rng.random((2, 4 * 4096))
     for threads in (1, 2):
-        out = np.full((2, 1001), -1, dtype=np.int32)
+        out = np.full((2, 20001), -1, dtype=np.int32)
         kept = []
         for k in range(threads):
-            r = rec[k].reshape(64, 4)
+            r = rec[k].reshape(4096, 4)
             near = (r[:, 0] - 0.5) ** 2 + (r[:, 1] - 0.5) ** 2 < 0.232
             kept.append(nbrs[k][near[nbrs[k]]])
         assert mod.keep_near_cores(3, threads, nbrs, rec, out) == 3 * sum(len(kk) for kk in kept)
